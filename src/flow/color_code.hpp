@@ -1,0 +1,23 @@
+// Middlebury colour coding of flow (Baker et al. 2011; the paper's Fig. 10).
+//
+//   cv::Mat bgr = roiflow::flow::flow_to_color(flow);        // CV_8UC3, for cv::imwrite
+//   cv::Mat key = roiflow::flow::color_wheel_legend(151);    // the wheel, as a legend
+//
+// Hue gives the direction (the 55-colour Middlebury wheel: RY 15, YG 6, GC 4, CB 11, BM 13,
+// MR 6), saturation the magnitude relative to `max_magnitude` (<= 0: the largest known
+// magnitude in the field). Unknown pixels (|u| or |v| > 1e9, NaN) are black.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+namespace roiflow::flow {
+
+cv::Mat flow_to_color(const cv::Mat& flow, float max_magnitude = -1.f);
+// A square legend of side `size` (odd sizes centre exactly): each pixel coloured by its own
+// offset from the centre, the rim at full magnitude.
+cv::Mat color_wheel_legend(int size = 151);
+// Draws flow vectors every `step` pixels on a BGR copy of `image` (arrows scaled by `scale`).
+cv::Mat draw_flow_vectors(const cv::Mat& image, const cv::Mat& flow, int step = 16,
+                          float scale = 1.f);
+
+}  // namespace roiflow::flow

@@ -1,0 +1,89 @@
+// Dense iterative pyramidal Lucas–Kanade optical flow (the paper's Algorithm 1).
+//
+//   using namespace roiflow::flow;
+//   FlowResult r = dense_flow(frame_t, frame_t1, LkParams::paper());
+//   cv::Mat flow = r.flow;            // CV_32FC2: (u, v) in pixels, u right, v down, t -> t+1
+//
+// For each pyramid level from coarse to fine: the flow of the coarser level is upsampled x2
+// (bilinear), frame t+1 is warped towards frame t with sub-pixel bilinear interpolation, and
+// `iterations` times every pixel solves the Tikhonov-regularised 2x2 least-squares system of
+// its patch:  (G + lambda I) w = b + lambda w_prev, G and b being window means of the
+// derivative products, linearised around each pixel's own current flow. Window sums come
+// from running sums, so one iteration costs O(1) per pixel whatever the patch size.
+//
+// Patch centring: a patch of n pixels always has total weight n and is centred on the pixel.
+// Derivatives live on the pixel grid (Scharr, central) or between pixels (Horn–Schunck's 2x2x2
+// cube, centred at x + 1/2). A window whose ends would fall half a pixel outside the grid
+// gets its two outermost rows/columns at weight 1/2 (n + 1 taps). So 10x10 with Horn–Schunck
+// derivatives is exactly the 10 half-pixel positions x-4.5 .. x+4.5, and 10x10 with Scharr
+// is 11 taps with half-weight ends: no half-pixel shift in either case.
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "flow/executor.hpp"
+#include "flow/pyramid.hpp"
+
+namespace roiflow::flow {
+
+enum class Derivative {
+  HornSchunck,  // 2x2x2 cube of Horn & Schunck: both frames, half-pixel grid (the paper's)
+  Scharr,       // 3x3 Scharr on the mean of frame t and warped t+1
+  Central,      // [-1 0 1]/2 on the mean of frame t and warped t+1
+};
+
+struct LkParams {
+  int patch = 10;       // window side in pixels, 3..31, even sizes allowed (see above)
+  int levels = 3;       // pyramid levels, 1..6 (fewer when the image is small)
+  int iterations = 3;   // refinement iterations per level, 1..50
+  double sigma = 1.0;   // pretreatment Gaussian sigma in pixels, 0 = off
+  Derivative derivative = Derivative::HornSchunck;
+  double lambda = 1e-4;  // Tikhonov weight, in (intensity/pixel)^2, intensities in [0, 1]
+  // Robust reweighting (IRLS): residuals r get weight 1 / (1 + (r / robust_scale)^2)
+  // (Cauchy). 0 = plain least squares.
+  double robust_scale = 0.0;
+  int level_median = 0;  // median filter (0 off, 3, 5) of the flow after each coarse level
+  int final_median = 0;  // median filter (0 off, 3, 5) of the final flow
+
+  static LkParams paper();     // patch 10, levels 3, iterations 3, Horn–Schunck
+  static LkParams accurate();  // tuned for the lowest error on real data
+  // "paper" or "accurate"; throws roiflow::Error naming the unknown preset.
+  static LkParams preset(std::string_view name);
+  static std::vector<std::string> preset_names();
+
+  // Throws roiflow::Error naming the first parameter out of range.
+  void validate() const;
+};
+
+struct FlowOptions {
+  // Region of frame t (level-0 pixels) where flow is wanted; empty = whole frame. The region
+  // is clipped to the frame; flow and confidence have the region's size.
+  cv::Rect region;
+  // Motion assumed before the coarsest level (e.g. a tracker's prediction), in pixels.
+  cv::Point2f initial_motion{0.f, 0.f};
+  // Runs row stripes; nullptr = serial.
+  const Executor* executor = nullptr;
+};
+
+struct FlowResult {
+  cv::Mat flow;        // CV_32FC2, (u, v) in pixels, region-sized
+  cv::Mat confidence;  // CV_32FC1, smallest eigenvalue of the window's structure tensor
+  cv::Rect region;     // where in frame t the result lies
+};
+
+// Flow from frame t to frame t+1. Both images: same size, types accepted by build_pyramid.
+FlowResult dense_flow(const cv::Mat& frame_t, const cv::Mat& frame_t1, const LkParams& params,
+                      const FlowOptions& options = {});
+
+// Same on pyramids built once per frame (a video frame serves two pairs). The pyramids must
+// have the same size and at least as many levels as effective_levels(size, params.levels).
+FlowResult dense_flow(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkParams& params,
+                      const FlowOptions& options = {});
+
+const char* to_string(Derivative d);
+Derivative derivative_from_string(std::string_view name);  // "hs", "scharr", "central"
+
+}  // namespace roiflow::flow

@@ -1,0 +1,35 @@
+// Gaussian image pyramid, the pretreatment and the multi-scale support of dense LK.
+//
+//   auto pyr = roiflow::flow::build_pyramid(gray8, /*levels=*/3, /*sigma=*/1.0);
+//   const cv::Mat& coarsest = pyr.levels.back();    // CV_32FC1, intensities in [0, 1]
+//
+// Level 0 is the input converted to float in [0, 1] and smoothed by a Gaussian of `sigma`
+// pixels (0 = no smoothing, the paper's pretreatment otherwise). Level k+1 is cv::pyrDown of
+// level k (5-tap Gaussian, factor 2, size (w+1)/2 x (h+1)/2, so pixel x of level k+1 sits at
+// 2x of level k). An image too small for the levels asked gets fewer levels: the coarsest
+// level keeps at least `kMinLevelSide` pixels on its shorter side.
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <vector>
+
+namespace roiflow::flow {
+
+inline constexpr int kMinLevelSide = 12;
+inline constexpr int kMaxLevels = 6;
+
+struct Pyramid {
+  std::vector<cv::Mat> levels;  // CV_32FC1, level 0 full resolution
+  int num_levels() const { return static_cast<int>(levels.size()); }
+  cv::Size size() const { return levels.empty() ? cv::Size() : levels[0].size(); }
+};
+
+// Number of levels build_pyramid really builds for an image of `size` when `requested` are
+// asked (1..kMaxLevels; throws roiflow::Error outside that range).
+int effective_levels(cv::Size size, int requested);
+
+// Accepts CV_8UC1, CV_8UC3 (BGR, converted to gray), CV_16UC1 and CV_32FC1 (taken as [0, 1]).
+// Throws roiflow::Error on an empty image, another type, or sigma < 0 or > 20.
+Pyramid build_pyramid(const cv::Mat& image, int levels, double sigma);
+
+}  // namespace roiflow::flow
