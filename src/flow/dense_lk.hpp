@@ -36,12 +36,14 @@ enum class Derivative {
 };
 
 struct LkParams {
-  int patch = 10;       // window side in pixels, 3..31, even sizes allowed (see above)
-  int levels = 3;       // pyramid levels, 1..6 (fewer when the image is small)
-  int iterations = 3;   // refinement iterations per level, 1..50
-  double sigma = 1.0;   // pretreatment Gaussian sigma in pixels, 0 = off
+  int patch = 10;      // window side in pixels, 3..31, even sizes allowed (see above)
+  int levels = 3;      // pyramid levels, 1..6 (fewer when the image is small)
+  int iterations = 3;  // refinement iterations per level, 1..50
+  double sigma = 0.5;  // pretreatment Gaussian sigma in pixels, 0 = off
   Derivative derivative = Derivative::HornSchunck;
-  double lambda = 1e-4;  // Tikhonov weight, in (intensity/pixel)^2, intensities in [0, 1]
+  // Tikhonov weight, in (intensity/pixel)^2 with intensities in [0, 1]: it keeps textureless
+  // windows at their previous (coarser-level) flow instead of solving a singular system.
+  double lambda = 1e-6;
   // Robust reweighting (IRLS): residuals r get weight 1 / (1 + (r / robust_scale)^2)
   // (Cauchy). 0 = plain least squares.
   double robust_scale = 0.0;

@@ -1,0 +1,75 @@
+#include "flow/pyramid.hpp"
+
+#include <opencv2/imgproc.hpp>
+#include <string>
+
+#include "flow/error.hpp"
+
+namespace roiflow::flow {
+
+int effective_levels(cv::Size size, int requested) {
+  if (requested < 1 || requested > kMaxLevels) {
+    throw Error("levels must be in 1.." + std::to_string(kMaxLevels) + ", got " +
+                std::to_string(requested));
+  }
+  int levels = 1;
+  int w = size.width, h = size.height;
+  while (levels < requested) {
+    const int nw = (w + 1) / 2, nh = (h + 1) / 2;
+    if (std::min(nw, nh) < kMinLevelSide) break;
+    w = nw;
+    h = nh;
+    ++levels;
+  }
+  return levels;
+}
+
+namespace {
+
+cv::Mat to_unit_float(const cv::Mat& image) {
+  cv::Mat out;
+  switch (image.type()) {
+    case CV_8UC1:
+      image.convertTo(out, CV_32F, 1.0 / 255.0);
+      break;
+    case CV_8UC3: {
+      cv::Mat gray;
+      cv::cvtColor(image, gray, cv::COLOR_BGR2GRAY);
+      gray.convertTo(out, CV_32F, 1.0 / 255.0);
+      break;
+    }
+    case CV_16UC1:
+      image.convertTo(out, CV_32F, 1.0 / 65535.0);
+      break;
+    case CV_32FC1:
+      out = image.clone();
+      break;
+    default:
+      throw Error("image type must be 8-bit gray, 8-bit BGR, 16-bit gray or float gray, got " +
+                  cv::typeToString(image.type()));
+  }
+  return out;
+}
+
+}  // namespace
+
+Pyramid build_pyramid(const cv::Mat& image, int levels, double sigma) {
+  if (image.empty()) throw Error("image is empty");
+  if (!(sigma >= 0.0 && sigma <= 20.0)) {
+    throw Error("smoothing sigma must be in [0, 20], got " + std::to_string(sigma));
+  }
+  const int n = effective_levels(image.size(), levels);
+  Pyramid pyr;
+  pyr.levels.reserve(n);
+  cv::Mat base = to_unit_float(image);
+  if (sigma > 0.0) cv::GaussianBlur(base, base, cv::Size(), sigma, sigma, cv::BORDER_REPLICATE);
+  pyr.levels.push_back(base);
+  for (int l = 1; l < n; ++l) {
+    cv::Mat down;
+    cv::pyrDown(pyr.levels.back(), down);
+    pyr.levels.push_back(down);
+  }
+  return pyr;
+}
+
+}  // namespace roiflow::flow
