@@ -13,10 +13,12 @@
 namespace roiflow::flow {
 
 cv::Mat flow_to_color(const cv::Mat& flow, float max_magnitude = -1.f);
-// A square legend of side `size` (odd sizes centre exactly): each pixel coloured by its own
-// offset from the centre, the rim at full magnitude.
+// A square legend of side `size` >= 3 (odd sizes centre exactly): each pixel coloured by its
+// own offset from the centre, the inscribed circle's rim at full magnitude; white outside the
+// circle (black would read as "unknown").
 cv::Mat color_wheel_legend(int size = 151);
-// Draws flow vectors every `step` pixels on a BGR copy of `image` (arrows scaled by `scale`).
+// Draws green flow vectors every `step` pixels (from step/2), skipping unknown flow, on a BGR
+// copy of `image` (CV_8UC1 or CV_8UC3, same size as `flow`); arrows scaled by `scale`.
 cv::Mat draw_flow_vectors(const cv::Mat& image, const cv::Mat& flow, int step = 16,
                           float scale = 1.f);
 

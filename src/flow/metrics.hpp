@@ -14,20 +14,22 @@
 namespace roiflow::flow {
 
 struct FlowErrors {
-  double aae_deg = 0;  // mean angular error, degrees
-  double epe = 0;      // mean endpoint error, pixels
-  double r1 = 0;       // % of pixels with EPE > 1
-  double r3 = 0;       // % of pixels with EPE > 3
+  double aae_deg = 0;    // mean angular error, degrees
+  double epe = 0;        // mean endpoint error, pixels
+  double r1 = 0;         // % of pixels with EPE > 1
+  double r3 = 0;         // % of pixels with EPE > 3
   long long pixels = 0;  // pixels counted
 };
 
 bool is_known_flow(float u, float v);
 
-// Throws roiflow::Error when types or sizes differ (message gives both sizes).
+// Throws roiflow::Error when types or sizes differ (message gives both sizes), and when the
+// estimate is NaN or infinite at a counted pixel (a silently wrong mean is worse).
+// No counted pixel: all metrics 0 and pixels 0, for the caller to judge.
 FlowErrors flow_errors(const cv::Mat& estimate, const cv::Mat& ground_truth,
                        const cv::Mat& exclude = cv::Mat());
 
-// Per-pixel endpoint error (CV_32FC1), 0 at unknown or excluded pixels.
+// Per-pixel endpoint error (CV_32FC1), 0 at unknown ground-truth pixels; throws as above.
 cv::Mat endpoint_error_image(const cv::Mat& estimate, const cv::Mat& ground_truth);
 
 }  // namespace roiflow::flow
