@@ -17,7 +17,8 @@ namespace roiflow::flow {
 
 enum class SceneKind {
   Translation,   // sub-pixel translation (parameter: (1.3, -0.7) px by default)
-  Rotation,      // rotation about the centre (3 degrees)
+  Rotation,      // 3 degrees about the centre ((w-1)/2, (h-1)/2), counter-clockwise on
+                 // screen: y points down, so a point right of the centre moves up (v < 0)
   Zoom,          // isotropic scale about the centre (+4 %)
   NonRigid,      // smooth sinusoidal deformation field, amplitude ~2 px
   MovingObject,  // textured rectangle moving over a differently moving textured background
@@ -29,9 +30,11 @@ struct Scene {
   cv::Mat flow;    // CV_32FC2 ground truth, frame0 -> frame1
 };
 
+// Throws roiflow::Error when a side of `size` is outside 8..8192.
 Scene make_scene(SceneKind kind, cv::Size size, std::uint64_t seed = 1);
 
-// A translation by an arbitrary (dx, dy), for speed and range tests.
+// A translation by an arbitrary (dx, dy), for speed and range tests. Throws roiflow::Error
+// also when |dx| or |dy| exceeds 8192.
 Scene make_translation(cv::Size size, cv::Point2f motion, std::uint64_t seed = 1);
 
 const char* to_string(SceneKind kind);
