@@ -1,0 +1,165 @@
+// Dense flow, roiflow against OpenCV's dense methods on the same synthetic frames. One binary,
+// so speed ratios come from one run, next to each method's endpoint error.
+//
+//   build/release/bench/flow_bench --benchmark_filter=640x480
+//
+//   BM_Flow/<method>/<W>x<H>/threads:<n>   method: roiflow_paper, roiflow_accurate,
+//                                          dis_ultrafast, dis_fast, dis_medium, farneback
+//   BM_Pyramid/<W>x<H>                     build_pyramid(frame, 3, 1.0) alone, one thread
+//
+// Every benchmark runs inside run_with_threads(n): n arena slots for roiflow's stripes and
+// cv::setNumThreads(n) for OpenCV's own loops (DIS, Farneback, and the remap/pyrDown roiflow
+// calls). Times are wall-clock ("/real_time" in the reported names): CPU time of the main thread
+// would hide the work done by the others. Counters: Mpix/s, frame pixels per wall-clock second;
+// EPE, mean endpoint error in pixels against the ground truth, measured on the last flow of the
+// timing loop. Frames: make_scene(MovingObject), built once per size on first use.
+#include <benchmark/benchmark.h>
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <opencv2/video/tracking.hpp>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "flow/dense_lk.hpp"
+#include "flow/metrics.hpp"
+#include "flow/pyramid.hpp"
+#include "flow/synthetic.hpp"
+#include "pipeline/tbb_executor.hpp"
+
+namespace {
+
+using roiflow::flow::Scene;
+
+constexpr std::uint64_t kSeed = 1;
+const cv::Size kSizes[] = {{640, 480}, {1280, 720}};
+constexpr int kThreadCounts[] = {1, 2};
+
+const Scene& scene_of(cv::Size size) {
+  // Benchmarks run one after another on the main thread, so the cache needs no lock.
+  static std::map<std::pair<int, int>, Scene> scenes;
+  auto [it, inserted] = scenes.try_emplace({size.width, size.height});
+  if (inserted)
+    it->second = roiflow::flow::make_scene(roiflow::flow::SceneKind::MovingObject, size, kSeed);
+  return it->second;
+}
+
+std::string size_name(cv::Size size) {
+  return std::to_string(size.width) + "x" + std::to_string(size.height);
+}
+
+void set_rate(benchmark::State& state, cv::Size size) {
+  state.counters["Mpix/s"] = benchmark::Counter(
+      static_cast<double>(state.iterations()) * size.area() / 1e6, benchmark::Counter::kIsRate);
+}
+
+// Writes the CV_32FC2 flow from frame0 to frame1 of the scene.
+using FlowFn = std::function<void(const Scene&, cv::Mat&)>;
+
+struct Method {
+  const char* name;
+  // Called once per benchmark run, outside the timing loop, so per-instance set-up (DIS's
+  // buffers) is not timed.
+  std::function<FlowFn()> make;
+};
+
+FlowFn roiflow_flow(const roiflow::flow::LkParams& params) {
+  // Stateless, and it runs in whichever arena run_with_threads set up: one serves every run.
+  static const roiflow::pipeline::TbbExecutor executor;
+  roiflow::flow::FlowOptions options;
+  options.executor = &executor;
+  return [params, options](const Scene& s, cv::Mat& flow) {
+    flow = roiflow::flow::dense_flow(s.frame0, s.frame1, params, options).flow;
+  };
+}
+
+FlowFn dis_flow(int preset) {
+  cv::Ptr<cv::DISOpticalFlow> dis = cv::DISOpticalFlow::create(preset);
+  return [dis](const Scene& s, cv::Mat& flow) { dis->calc(s.frame0, s.frame1, flow); };
+}
+
+FlowFn farneback_flow() {
+  return [](const Scene& s, cv::Mat& flow) {
+    // OpenCV's sample parameters (samples/cpp/fback.cpp).
+    cv::calcOpticalFlowFarneback(s.frame0, s.frame1, flow, 0.5, 3, 15, 3, 5, 1.2, 0);
+  };
+}
+
+const std::vector<Method>& methods() {
+  static const std::vector<Method> all = {
+      {"roiflow_paper", [] { return roiflow_flow(roiflow::flow::LkParams::paper()); }},
+      {"roiflow_accurate", [] { return roiflow_flow(roiflow::flow::LkParams::accurate()); }},
+      {"dis_ultrafast", [] { return dis_flow(cv::DISOpticalFlow::PRESET_ULTRAFAST); }},
+      {"dis_fast", [] { return dis_flow(cv::DISOpticalFlow::PRESET_FAST); }},
+      {"dis_medium", [] { return dis_flow(cv::DISOpticalFlow::PRESET_MEDIUM); }},
+      {"farneback", farneback_flow},
+  };
+  return all;
+}
+
+void bm_flow(benchmark::State& state, const Method& method, cv::Size size, int threads) {
+  const Scene& scene = scene_of(size);
+  roiflow::pipeline::run_with_threads(threads, [&] {
+    const FlowFn flow_fn = method.make();
+    cv::Mat flow;
+    // Untimed first call: allocates the output and wakes the arena's workers, which would
+    // otherwise be charged to the first timed iteration.
+    flow_fn(scene, flow);
+    for (auto _ : state) {
+      flow_fn(scene, flow);
+      benchmark::DoNotOptimize(flow.data);
+      benchmark::ClobberMemory();
+    }
+    set_rate(state, size);
+    state.counters["EPE"] = roiflow::flow::flow_errors(flow, scene.flow).epe;
+  });
+}
+
+void bm_pyramid(benchmark::State& state, cv::Size size) {
+  const Scene& scene = scene_of(size);
+  roiflow::pipeline::run_with_threads(1, [&] {
+    for (auto _ : state) {
+      roiflow::flow::Pyramid pyr = roiflow::flow::build_pyramid(scene.frame0, 3, 1.0);
+      benchmark::DoNotOptimize(pyr.levels.data());
+    }
+    set_rate(state, size);
+  });
+}
+
+void register_benchmarks() {
+  for (const cv::Size size : kSizes) {
+    for (const Method& method : methods()) {
+      for (const int threads : kThreadCounts) {
+        const std::string name = "BM_Flow/" + std::string(method.name) + "/" + size_name(size) +
+                                 "/threads:" + std::to_string(threads);
+        benchmark::RegisterBenchmark(name.c_str(), bm_flow, method, size, threads)
+            ->Unit(benchmark::kMillisecond)
+            ->UseRealTime();
+      }
+    }
+    benchmark::RegisterBenchmark(("BM_Pyramid/" + size_name(size)).c_str(), bm_pyramid, size)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  register_benchmarks();
+  // The default minimum time goes in as the first flag so that a --benchmark_min_time on the
+  // command line still wins; Benchmark::MinTime() would override the command line and add
+  // "/min_time:" to every name.
+  std::string default_min_time = "--benchmark_min_time=0.5";
+  std::vector<char*> args(argv, argv + argc);
+  args.insert(args.begin() + 1, default_min_time.data());
+  int args_count = static_cast<int>(args.size());
+  args.push_back(nullptr);
+  benchmark::Initialize(&args_count, args.data());
+  if (benchmark::ReportUnrecognizedArguments(args_count, args.data())) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -1,0 +1,58 @@
+#include "pipeline/tbb_executor.hpp"
+
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/partitioner.h>
+
+#include <algorithm>
+#include <cstddef>
+#include <opencv2/core/utility.hpp>
+#include <string>
+
+#include "flow/error.hpp"
+
+namespace roiflow::pipeline {
+
+namespace {
+
+int validated_thread_count(int threads) {
+  if (threads < 1 || threads > kMaxThreads) {
+    throw Error("thread count must be in 1.." + std::to_string(kMaxThreads) + ", got " +
+                std::to_string(threads));
+  }
+  return threads;
+}
+
+}  // namespace
+
+void TbbExecutor::for_range(int begin, int end, int grain,
+                            const std::function<void(int, int)>& body) const {
+  if (begin >= end) return;
+  // With one thread there is nobody to share with, and every extra stripe costs the flow core
+  // its halo rows again.
+  if (tbb::this_task_arena::max_concurrency() == 1) {
+    body(begin, end);
+    return;
+  }
+  // blocked_range halves a range whose size exceeds its grainsize, so a grainsize of
+  // 2 * grain - 1 is what keeps both halves at least `grain` long.
+  const auto min_size = static_cast<std::size_t>(std::max(grain, 1));
+  const tbb::blocked_range<int> range(begin, end, 2 * min_size - 1);
+  // auto_partitioner, not simple_partitioner: stripes cost the same per row, so a few big
+  // chunks per thread balance as well as many small ones, and every extra stripe repeats the
+  // flow core's per-stripe setup. `grain` stays a floor, not the chunk size.
+  tbb::parallel_for(
+      range, [&body](const tbb::blocked_range<int>& r) { body(r.begin(), r.end()); },
+      tbb::auto_partitioner());
+}
+
+ThreadScope::ThreadScope(int threads)
+    : previous_cv_threads_(cv::getNumThreads()), arena_(validated_thread_count(threads)) {
+  cv::setNumThreads(threads);
+}
+
+ThreadScope::~ThreadScope() {
+  cv::setNumThreads(previous_cv_threads_);
+}
+
+}  // namespace roiflow::pipeline
