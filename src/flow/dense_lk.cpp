@@ -5,6 +5,7 @@
 #include <immintrin.h>
 #endif
 #include <cmath>
+#include <memory>
 #include <opencv2/imgproc.hpp>
 #include <string>
 
@@ -64,8 +65,7 @@ struct WarpedRow {
 // iterations of a level allocate nothing.
 struct RowScratch {
   WarpedRow warp_cache[4];
-  std::vector<float> ring, colsum, col, win, delta, zero_row, deriv;
-  std::vector<int> ring_row_id;
+  std::vector<float> ring, colsum, col, prefix;
 };
 
 RowScratch& thread_scratch() {
@@ -74,8 +74,7 @@ RowScratch& thread_scratch() {
 }
 
 // Frame t+1 sampled bilinearly at x + flow(x) along one row (border replicated), returned
-// as the mean with frame t, m = (I0 + I1w) / 2, and the difference d = I1w - I0. Written
-// without branches so that the compiler can use gathers.
+// as the mean with frame t, m = (I0 + I1w) / 2, and the difference d = I1w - I0.
 void warp_row(const cv::Mat& i1, const float* __restrict i0, int x0, int y, int w,
               const float* __restrict u, const float* __restrict v, float* __restrict m,
               float* __restrict d) {
@@ -85,7 +84,56 @@ void warp_row(const cv::Mat& i1, const float* __restrict i0, int x0, int y, int 
   const float xhi = static_cast<float>(i1.cols - 1), yhi = static_cast<float>(i1.rows - 1);
   const int ixmax = std::max(0, i1.cols - 2), iymax = std::max(0, i1.rows - 2);
   const float fy0 = static_cast<float>(y);
-  for (int x = 0; x < w; ++x) {
+  int x = 0;
+#ifdef __AVX2__
+  if (dx1 == 1 && dy1 == step) {
+    // Each pixel needs two horizontal pairs (p00, p01) and (p10, p11): gathering them as
+    // 64-bit pairs halves the gathered elements, which is what gathers cost on x86.
+    const __m256 lane = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7);
+    const __m256 zero = _mm256_setzero_ps(), vxhi = _mm256_set1_ps(xhi);
+    const __m256 vyhi = _mm256_set1_ps(yhi), vy = _mm256_set1_ps(fy0), half = _mm256_set1_ps(0.5f);
+    const __m256i vixmax = _mm256_set1_epi32(ixmax), viymax = _mm256_set1_epi32(iymax);
+    const __m256i vstep = _mm256_set1_epi32(step);
+    const __m128i step4 = _mm_set1_epi32(step);
+    const auto* pairs = reinterpret_cast<const double*>(base);
+    // The masked form with an explicit source: the plain intrinsic leaves its source
+    // undefined, which GCC reports as maybe-uninitialised.
+    const __m256d all = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
+    auto gather = [&](__m128i index) {
+      return _mm256_mask_i32gather_pd(_mm256_setzero_pd(), pairs, index, all, 4);
+    };
+    auto split = [](__m256d lo, __m256d hi, __m256& first, __m256& second) {
+      const __m256 a = _mm256_castpd_ps(lo), b = _mm256_castpd_ps(hi);
+      first = _mm256_castpd_ps(
+          _mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(a, b, 0x88)), 0xD8));
+      second = _mm256_castpd_ps(
+          _mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(a, b, 0xDD)), 0xD8));
+    };
+    for (; x + 8 <= w; x += 8) {
+      const __m256 xs = _mm256_add_ps(_mm256_set1_ps(static_cast<float>(x0 + x)), lane);
+      const __m256 sx =
+          _mm256_min_ps(_mm256_max_ps(_mm256_add_ps(xs, _mm256_loadu_ps(u + x)), zero), vxhi);
+      const __m256 sy =
+          _mm256_min_ps(_mm256_max_ps(_mm256_add_ps(vy, _mm256_loadu_ps(v + x)), zero), vyhi);
+      const __m256i ix = _mm256_min_epi32(_mm256_cvttps_epi32(sx), vixmax);
+      const __m256i iy = _mm256_min_epi32(_mm256_cvttps_epi32(sy), viymax);
+      const __m256 fx = _mm256_sub_ps(sx, _mm256_cvtepi32_ps(ix));
+      const __m256 fy = _mm256_sub_ps(sy, _mm256_cvtepi32_ps(iy));
+      const __m256i idx = _mm256_add_epi32(_mm256_mullo_epi32(iy, vstep), ix);
+      const __m128i idx_lo = _mm256_castsi256_si128(idx), idx_hi = _mm256_extracti128_si256(idx, 1);
+      __m256 p00, p01, p10, p11;
+      split(gather(idx_lo), gather(idx_hi), p00, p01);
+      split(gather(_mm_add_epi32(idx_lo, step4)), gather(_mm_add_epi32(idx_hi, step4)), p10, p11);
+      const __m256 top = _mm256_fmadd_ps(fx, _mm256_sub_ps(p01, p00), p00);
+      const __m256 bot = _mm256_fmadd_ps(fx, _mm256_sub_ps(p11, p10), p10);
+      const __m256 w1 = _mm256_fmadd_ps(fy, _mm256_sub_ps(bot, top), top);
+      const __m256 a = _mm256_loadu_ps(i0 + x);
+      _mm256_storeu_ps(m + x, _mm256_mul_ps(half, _mm256_add_ps(a, w1)));
+      _mm256_storeu_ps(d + x, _mm256_sub_ps(w1, a));
+    }
+  }
+#endif
+  for (; x < w; ++x) {
     const float sx = std::min(std::max(static_cast<float>(x0 + x) + u[x], 0.f), xhi);
     const float sy = std::min(std::max(fy0 + v[x], 0.f), yhi);
     const int ix = std::min(static_cast<int>(sx), ixmax);
@@ -102,126 +150,218 @@ void warp_row(const cv::Mat& i1, const float* __restrict i0, int x0, int y, int 
   }
 }
 
-// Padding replicates the last column, so x + 1 is valid there and gives a zero step.
-void hs_derivatives(const WarpedRow& a, const WarpedRow& b, int w, float* __restrict ix,
-                    float* __restrict iy, float* __restrict it, float* __restrict ub,
-                    float* __restrict vb) {
-  const float* __restrict m0 = a.m.data() + 1;
-  const float* __restrict m1 = b.m.data() + 1;
-  const float* __restrict d0 = a.d.data() + 1;
-  const float* __restrict d1 = b.d.data() + 1;
-  const float* __restrict u0 = a.u.data() + 1;
-  const float* __restrict u1 = b.u.data() + 1;
-  const float* __restrict v0 = a.v.data() + 1;
-  const float* __restrict v1 = b.v.data() + 1;
-  for (int x = 0; x < w; ++x) {
-    ix[x] = 0.5f * ((m0[x + 1] - m0[x]) + (m1[x + 1] - m1[x]));
-    iy[x] = 0.5f * ((m1[x] - m0[x]) + (m1[x + 1] - m0[x + 1]));
-    it[x] = 0.25f * (d0[x] + d0[x + 1] + d1[x] + d1[x + 1]);
-    ub[x] = 0.25f * (u0[x] + u0[x + 1] + u1[x] + u1[x + 1]);
-    vb[x] = 0.25f * (v0[x] + v0[x + 1] + v1[x] + v1[x + 1]);
-  }
-}
-
-// Scharr (3x3) or central differences on the pixel grid, rows up / centre / down.
-void grid_derivatives(bool scharr, const WarpedRow& up, const WarpedRow& centre,
-                      const WarpedRow& down, int w, float* __restrict ix, float* __restrict iy,
-                      float* __restrict it, float* __restrict ub, float* __restrict vb) {
-  const float* __restrict mu = up.m.data() + 1;
-  const float* __restrict mc = centre.m.data() + 1;
-  const float* __restrict md = down.m.data() + 1;
-  if (scharr) {
-    constexpr float k = 1.f / 32.f;
-    for (int x = 0; x < w; ++x) {
-      ix[x] = k * (3.f * (mu[x + 1] - mu[x - 1]) + 10.f * (mc[x + 1] - mc[x - 1]) +
-                   3.f * (md[x + 1] - md[x - 1]));
-      iy[x] = k * (3.f * (md[x - 1] - mu[x - 1]) + 10.f * (md[x] - mu[x]) +
-                   3.f * (md[x + 1] - mu[x + 1]));
-    }
-  } else {
-    for (int x = 0; x < w; ++x) {
-      ix[x] = 0.5f * (mc[x + 1] - mc[x - 1]);
-      iy[x] = 0.5f * (md[x] - mu[x]);
-    }
-  }
-  std::copy(centre.d.data() + 1, centre.d.data() + 1 + w, it);
-  std::copy(centre.u.data() + 1, centre.u.data() + 1 + w, ub);
-  std::copy(centre.v.data() + 1, centre.v.data() + 1 + w, vb);
-}
-
-// The five window terms of one derivative-grid row: Ix², IxIy, Iy² and Ix·r, Iy·r with
+// The five window terms of one derivative-grid row are Ix², IxIy, Iy² and Ix·r, Iy·r with
 // r = Ix·ū + Iy·v̄ − It, the brightness equation linearised around the local flow (ū, v̄).
+// Each kernel below computes them for one row, stores them in the ring slot of the row that
+// leaves the vertical window (kLeaving: there is one) and moves the vertical running sums by
+// the difference, all in one pass. Ix, Iy come from the mean image m, It from d; row padding
+// replicates the edge columns, so x - 1 and x + 1 are always valid. Every pointer is a
+// restrict parameter: GCC vectorises only with that guarantee.
+struct WindowTerms {
+  float wix, wiy, ix, iy, r;
+};
+
 template <bool kRobust>
-void emit_products(int w, const float* __restrict ix, const float* __restrict iy,
-                   const float* __restrict it, const float* __restrict ub,
-                   const float* __restrict vb, float inv_s2, float* __restrict out) {
-  float* __restrict gxx = out;
-  float* __restrict gxy = out + w;
-  float* __restrict gyy = out + 2 * w;
-  float* __restrict bx = out + 3 * w;
-  float* __restrict by = out + 4 * w;
+inline WindowTerms window_terms(float ix, float iy, float it, float ub, float vb, float inv_s2) {
+  float wgt = 1.f;
+  if constexpr (kRobust) wgt = 1.f / (1.f + it * it * inv_s2);
+  return {wgt * ix, wgt * iy, ix, iy, ix * ub + iy * vb - it};
+}
+
+template <bool kLeaving>
+inline void enter(float* __restrict ring, float* __restrict sum, int x, float value) {
+  sum[x] += kLeaving ? value - ring[x] : value;
+  ring[x] = value;
+}
+
+template <bool kLeaving>
+inline void enter_all(const WindowTerms& t, int w, int x, float* __restrict ring,
+                      float* __restrict acc) {
+  enter<kLeaving>(ring, acc, x, t.wix * t.ix);
+  enter<kLeaving>(ring + w, acc + w, x, t.wix * t.iy);
+  enter<kLeaving>(ring + 2 * w, acc + 2 * w, x, t.wiy * t.iy);
+  enter<kLeaving>(ring + 3 * w, acc + 3 * w, x, t.wix * t.r);
+  enter<kLeaving>(ring + 4 * w, acc + 4 * w, x, t.wiy * t.r);
+}
+
+// Horn–Schunck's 2x2x2 cube between rows a, b and columns x, x + 1 (grid at +1/2).
+template <bool kRobust, bool kLeaving>
+void hs_window_terms(int w, const float* __restrict m0, const float* __restrict m1,
+                     const float* __restrict d0, const float* __restrict d1,
+                     const float* __restrict u0, const float* __restrict u1,
+                     const float* __restrict v0, const float* __restrict v1, float inv_s2,
+                     float* __restrict ring, float* __restrict acc) {
+  // The five channel rows of `ring` and `acc` are disjoint (w apart): no dependence.
+#pragma GCC ivdep
   for (int x = 0; x < w; ++x) {
-    float wix = ix[x], wiy = iy[x];
-    if constexpr (kRobust) {
-      const float wgt = 1.f / (1.f + it[x] * it[x] * inv_s2);
-      wix *= wgt;
-      wiy *= wgt;
-    }
-    const float r = ix[x] * ub[x] + iy[x] * vb[x] - it[x];
-    gxx[x] = wix * ix[x];
-    gxy[x] = wix * iy[x];
-    gyy[x] = wiy * iy[x];
-    bx[x] = wix * r;
-    by[x] = wiy * r;
+    const float ix = 0.5f * ((m0[x + 1] - m0[x]) + (m1[x + 1] - m1[x]));
+    const float iy = 0.5f * ((m1[x] - m0[x]) + (m1[x + 1] - m0[x + 1]));
+    const float it = 0.25f * (d0[x] + d0[x + 1] + d1[x] + d1[x + 1]);
+    const float ub = 0.25f * (u0[x] + u0[x + 1] + u1[x] + u1[x + 1]);
+    const float vb = 0.25f * (v0[x] + v0[x + 1] + v1[x] + v1[x + 1]);
+    enter_all<kLeaving>(window_terms<kRobust>(ix, iy, it, ub, vb, inv_s2), w, x, ring, acc);
   }
 }
 
-// out[i] = in[0] + ... + in[i].
-void inclusive_prefix(const float* __restrict in, int n, float* __restrict out) {
-  int i = 0;
-  float carry = 0.f;
-#ifdef __AVX2__
-  __m256 vcarry = _mm256_setzero_ps();
-  for (; i + 8 <= n; i += 8) {
-    __m256 x = _mm256_loadu_ps(in + i);
-    x = _mm256_add_ps(x, _mm256_castsi256_ps(_mm256_slli_si256(_mm256_castps_si256(x), 4)));
-    x = _mm256_add_ps(x, _mm256_castsi256_ps(_mm256_slli_si256(_mm256_castps_si256(x), 8)));
-    // Each 128-bit half now holds its own prefix; carry the low half's total into the high.
-    const __m256 low_total = _mm256_permute_ps(x, _MM_SHUFFLE(3, 3, 3, 3));
-    x = _mm256_add_ps(x, _mm256_permute2f128_ps(low_total, low_total, 0x08));
-    x = _mm256_add_ps(x, vcarry);
-    _mm256_storeu_ps(out + i, x);
-    const __m256 last = _mm256_permute_ps(x, _MM_SHUFFLE(3, 3, 3, 3));
-    vcarry = _mm256_permute2f128_ps(last, last, 0x11);
+// 3x3 Scharr (kScharr) or central differences on the pixel grid, rows up / centre / down.
+template <bool kScharr, bool kRobust, bool kLeaving>
+void grid_window_terms(int w, const float* __restrict mu, const float* __restrict mc,
+                       const float* __restrict md, const float* __restrict dc,
+                       const float* __restrict uc, const float* __restrict vc, float inv_s2,
+                       float* __restrict ring, float* __restrict acc) {
+  // The five channel rows of `ring` and `acc` are disjoint (w apart): no dependence.
+#pragma GCC ivdep
+  for (int x = 0; x < w; ++x) {
+    float ix, iy;
+    if constexpr (kScharr) {
+      constexpr float k = 1.f / 32.f;
+      ix = k * (3.f * (mu[x + 1] - mu[x - 1]) + 10.f * (mc[x + 1] - mc[x - 1]) +
+                3.f * (md[x + 1] - md[x - 1]));
+      iy = k *
+           (3.f * (md[x - 1] - mu[x - 1]) + 10.f * (md[x] - mu[x]) + 3.f * (md[x + 1] - mu[x + 1]));
+    } else {
+      ix = 0.5f * (mc[x + 1] - mc[x - 1]);
+      iy = 0.5f * (md[x] - mu[x]);
+    }
+    enter_all<kLeaving>(window_terms<kRobust>(ix, iy, dc[x], uc[x], vc[x], inv_s2), w, x, ring,
+                        acc);
   }
-  carry = _mm256_cvtss_f32(vcarry);
+}
+
+template <bool kRobust, bool kLeaving>
+void row_window_terms(Derivative derivative, const WarpedRow& up, const WarpedRow& centre,
+                      const WarpedRow& down, int w, float inv_s2, float* ring, float* acc) {
+  auto at = [](const std::vector<float>& v) { return v.data() + 1; };
+  switch (derivative) {
+    case Derivative::HornSchunck:
+      // The cube spans this row and the next: `centre` and `down`.
+      hs_window_terms<kRobust, kLeaving>(w, at(centre.m), at(down.m), at(centre.d), at(down.d),
+                                         at(centre.u), at(down.u), at(centre.v), at(down.v), inv_s2,
+                                         ring, acc);
+      break;
+    case Derivative::Scharr:
+      grid_window_terms<true, kRobust, kLeaving>(w, at(up.m), at(centre.m), at(down.m),
+                                                 at(centre.d), at(centre.u), at(centre.v), inv_s2,
+                                                 ring, acc);
+      break;
+    case Derivative::Central:
+      grid_window_terms<false, kRobust, kLeaving>(w, at(up.m), at(centre.m), at(down.m),
+                                                  at(centre.d), at(centre.u), at(centre.v), inv_s2,
+                                                  ring, acc);
+      break;
+  }
+}
+
+// Inclusive prefix sums of the kChannels rows in[c * in_stride + i], i < n, into
+// out[c * out_stride + i]. The channels' carry chains are independent, so interleaving them
+// hides the latency of the serial part.
+void prefix_scan(const float* __restrict in, int in_stride, int n, float* __restrict out,
+                 size_t out_stride) {
+  int i = 0;
+  float carry[kChannels] = {};
+#ifdef __AVX2__
+  __m256 vcarry[kChannels];
+  for (int c = 0; c < kChannels; ++c)
+    vcarry[c] = _mm256_setzero_ps();
+  for (; i + 8 <= n; i += 8) {
+    for (int c = 0; c < kChannels; ++c) {
+      __m256 x = _mm256_loadu_ps(in + static_cast<size_t>(c) * in_stride + i);
+      x = _mm256_add_ps(x, _mm256_castsi256_ps(_mm256_slli_si256(_mm256_castps_si256(x), 4)));
+      x = _mm256_add_ps(x, _mm256_castsi256_ps(_mm256_slli_si256(_mm256_castps_si256(x), 8)));
+      // Each 128-bit half now holds its own prefix; carry the low half's total into the high.
+      const __m256 low_total = _mm256_permute_ps(x, _MM_SHUFFLE(3, 3, 3, 3));
+      x = _mm256_add_ps(x, _mm256_permute2f128_ps(low_total, low_total, 0x08));
+      x = _mm256_add_ps(x, vcarry[c]);
+      _mm256_storeu_ps(out + c * out_stride + i, x);
+      const __m256 last = _mm256_permute_ps(x, _MM_SHUFFLE(3, 3, 3, 3));
+      vcarry[c] = _mm256_permute2f128_ps(last, last, 0x11);
+    }
+  }
+  for (int c = 0; c < kChannels; ++c)
+    carry[c] = _mm256_cvtss_f32(vcarry[c]);
 #endif
   for (; i < n; ++i) {
-    carry += in[i];
-    out[i] = carry;
+    for (int c = 0; c < kChannels; ++c) {
+      carry[c] += in[static_cast<size_t>(c) * in_stride + i];
+      out[c * out_stride + i] = carry[c];
+    }
   }
 }
 
+// Everything the per-row solve needs: prefix sums (padded, see RowIterator) from which each
+// window sum is one difference, the half-weight end columns when the window has them, and
+// the window weights.
+struct WindowSolve {
+  int w;
+  const float* prefix;
+  size_t prefix_stride;
+  const float* columns;  // non-null: subtract half of the end columns (zero-padded)
+  int column_stride;
+  int lo, hi;
+  const float* inv_cx;
+  float inv_cy;
+  float lambda;
+};
+
 // The regularised 2x2 solve of one row: (G + lambda I) w = b + lambda w_old, with G and b
-// the window means (sums times 1 / weight).
-void solve_pixels(int w, const float* __restrict sums, const float* __restrict inv_cx, float inv_cy,
-                  float lambda, const float* __restrict uo, const float* __restrict vo,
-                  float* __restrict un, float* __restrict vn) {
-  const float* __restrict sxx = sums;
-  const float* __restrict sxy = sums + w;
-  const float* __restrict syy = sums + 2 * w;
-  const float* __restrict sbx = sums + 3 * w;
-  const float* __restrict sby = sums + 4 * w;
-  for (int x = 0; x < w; ++x) {
+// the window means; optionally the smallest eigenvalue of G as the confidence.
+template <bool kHalf, bool kConfidence>
+void solve_row_impl(const WindowSolve& ws, const float* __restrict uo, const float* __restrict vo,
+                    float* __restrict un, float* __restrict vn, float* __restrict confidence) {
+  const size_t ps = ws.prefix_stride;
+  const float* __restrict p0 = ws.prefix;
+  const float* __restrict p1 = p0 + ps;
+  const float* __restrict p2 = p1 + ps;
+  const float* __restrict p3 = p2 + ps;
+  const float* __restrict p4 = p3 + ps;
+  const size_t cs = static_cast<size_t>(ws.column_stride);
+  const float* __restrict c0 = ws.columns;
+  const float* __restrict c1 = kHalf ? c0 + cs : nullptr;
+  const float* __restrict c2 = kHalf ? c1 + cs : nullptr;
+  const float* __restrict c3 = kHalf ? c2 + cs : nullptr;
+  const float* __restrict c4 = kHalf ? c3 + cs : nullptr;
+  const int lo = ws.lo - 1, hi = ws.hi, elo = ws.lo;
+  const float* __restrict inv_cx = ws.inv_cx;
+  const float inv_cy = ws.inv_cy, lambda = ws.lambda;
+  for (int x = 0; x < ws.w; ++x) {
+    float sxx = p0[x + hi] - p0[x + lo], sxy = p1[x + hi] - p1[x + lo];
+    float syy = p2[x + hi] - p2[x + lo], sbx = p3[x + hi] - p3[x + lo];
+    float sby = p4[x + hi] - p4[x + lo];
+    if constexpr (kHalf) {
+      sxx -= 0.5f * (c0[x + elo] + c0[x + hi]);
+      sxy -= 0.5f * (c1[x + elo] + c1[x + hi]);
+      syy -= 0.5f * (c2[x + elo] + c2[x + hi]);
+      sbx -= 0.5f * (c3[x + elo] + c3[x + hi]);
+      sby -= 0.5f * (c4[x + elo] + c4[x + hi]);
+    }
     const float n = inv_cx[x] * inv_cy;
-    const float gxy = sxy[x] * n;
-    const float a = sxx[x] * n + lambda, d = syy[x] * n + lambda;
-    const float ex = sbx[x] * n + lambda * uo[x], ey = sby[x] * n + lambda * vo[x];
+    const float gxx = sxx * n, gxy = sxy * n, gyy = syy * n;
+    const float a = gxx + lambda, d = gyy + lambda;
+    const float ex = sbx * n + lambda * uo[x], ey = sby * n + lambda * vo[x];
     const float inv_det = 1.f / (a * d - gxy * gxy);
     un[x] = (d * ex - gxy * ey) * inv_det;
     vn[x] = (a * ey - gxy * ex) * inv_det;
+    if constexpr (kConfidence) {
+      const float half_diff = 0.5f * (gxx - gyy);
+      confidence[x] =
+          std::max(0.f, 0.5f * (gxx + gyy) - std::sqrt(half_diff * half_diff + gxy * gxy));
+    }
   }
 }
+
+void solve_pixels(const WindowSolve& ws, const float* uo, const float* vo, float* un, float* vn,
+                  float* confidence) {
+  if (ws.columns) {
+    if (confidence) return solve_row_impl<true, true>(ws, uo, vo, un, vn, confidence);
+    return solve_row_impl<true, false>(ws, uo, vo, un, vn, confidence);
+  }
+  if (confidence) return solve_row_impl<false, true>(ws, uo, vo, un, vn, confidence);
+  solve_row_impl<false, false>(ws, uo, vo, un, vn, confidence);
+}
+
+// Rows per stripe handed to the executor; the vertical window sums restart at each stripe
+// boundary, so stripes much shorter than the window would waste work.
+constexpr int kStripeRows = 32;
 
 // One refinement iteration for rows [yb, ye) of the computed rectangle. Reads the previous
 // flow (planar, comp-sized), writes the new one. Everything a row needs is produced by
@@ -235,50 +375,72 @@ class RowIterator {
         v_old_(v_old),
         w_(p.comp.width),
         h_(p.comp.height),
-        ring_rows_(p.win.hi - p.win.lo + 2),
+        ring_rows_(p.win.hi - p.win.lo + 1),
         padded_(w_ + 2) {
     for (int i = 0; i < 4; ++i) {
       WarpedRow& e = warp_cache_[i];
       e.row = -1;
-      e.m.assign(padded_, 0.f);
-      e.d.assign(padded_, 0.f);
-      e.u.assign(padded_, 0.f);
-      e.v.assign(padded_, 0.f);
+      e.m.resize(padded_);
+      e.d.resize(padded_);
+      e.u.resize(padded_);
+      e.v.resize(padded_);
     }
-    ring_.assign(static_cast<size_t>(ring_rows_) * kChannels * w_, 0.f);
-    ring_row_id_.assign(ring_rows_, kNoRow);
+    // Rows of these buffers are always written before they are read: no clearing needed.
+    ring_.resize(static_cast<size_t>(ring_rows_) * kChannels * w_);
     colsum_.assign(static_cast<size_t>(kChannels) * w_, 0.f);
     hpad_lo_ = -p.win.lo;
     const int hpad = hpad_lo_ + w_ + p.win.hi + 1;
     col_.assign(static_cast<size_t>(kChannels) * hpad, 0.f);
     col_stride_ = hpad;
-    win_.assign(static_cast<size_t>(kChannels) * w_, 0.f);
-    delta_.assign(static_cast<size_t>(w_) + p.win.hi - p.win.lo + 2, 0.f);
-    deriv_.assign(static_cast<size_t>(kChannels) * w_, 0.f);
-    zero_row_.assign(static_cast<size_t>(kChannels) * w_, 0.f);
+    // Prefix sums per channel: 1 - lo zeros before column 0 and hi copies of the total after
+    // the last, so every window is prefix[x + hi] - prefix[x + lo - 1] without a clamp.
+    prefix_pad_ = 1 - p.win.lo;
+    prefix_stride_ = static_cast<size_t>(prefix_pad_ + w_ + p.win.hi);
+    prefix_.assign(kChannels * prefix_stride_, 0.f);
   }
 
+  // Rows [yb, ye) of the new flow. yb must be a multiple of kStripeRows (or 0).
   void run(int yb, int ye, float* u_new, float* v_new, float* confidence) {
     const Window& win = p_.win;
-    // Prime the vertical sum with the full window of row yb.
-    std::fill(colsum_.begin(), colsum_.end(), 0.f);
-    for (int s = yb + win.lo; s <= yb + win.hi; ++s)
-      add_row(products(s), 1.f);
+    for (int s = yb + win.lo; s < yb + win.hi; ++s)
+      advance(s, false);
     for (int y = yb; y < ye; ++y) {
-      if (y > yb) {
-        add_row(products(y + win.hi), 1.f);
-        add_row(products(y + win.lo - 1), -1.f);
+      advance(y + win.hi, y > yb);
+      // A running sum's rounding depends on where it started. Summing the window afresh at
+      // every stripe boundary makes the result independent of how rows are split among
+      // threads: bit-identical for any thread count.
+      if (y % kStripeRows == 0) resum_window(y);
+      const float* columns = colsum_.data();
+      int stride = w_;
+      if (win.half) {
+        half_weight_ends(y);
+        columns = col_.data() + hpad_lo_;
+        stride = col_stride_;
       }
-      vertical_output(y);
-      horizontal_sums();
-      solve_row(y, u_new + static_cast<size_t>(y) * w_, v_new + static_cast<size_t>(y) * w_,
-                confidence ? confidence + static_cast<size_t>(y) * w_ : nullptr);
+      const size_t pstride = prefix_stride_;
+      float* prefix = prefix_.data() + prefix_pad_;
+      prefix_scan(columns, stride, w_, prefix, pstride);
+      for (int c = 0; c < kChannels; ++c) {
+        float* pc = prefix + c * pstride;
+        std::fill(pc + w_, pc + w_ + win.hi, pc[w_ - 1]);
+      }
+      const size_t off = static_cast<size_t>(y) * w_;
+      WindowSolve ws{w_,
+                     prefix,
+                     pstride,
+                     win.half ? columns : nullptr,
+                     stride,
+                     win.lo,
+                     win.hi,
+                     p_.inv_cx.data(),
+                     1.f / p_.cy[y],
+                     p_.lambda};
+      solve_pixels(ws, u_old_ + off, v_old_ + off, u_new + off, v_new + off,
+                   confidence ? confidence + off : nullptr);
     }
   }
 
  private:
-  static constexpr int kNoRow = -1 << 30;
-
   // Mean image (I0 + warped I1) / 2, difference warped I1 - I0, and flow of row r of comp.
   const WarpedRow& warped(int r) {
     r = std::clamp(r, 0, h_ - 1);
@@ -300,105 +462,68 @@ class RowIterator {
     return e;
   }
 
-  // Weighted derivative products of derivative-grid row s (zeros outside the rectangle).
-  const float* products(int s) {
-    if (s < 0 || s >= h_) return zero_row_.data();
-    const int slot = ((s % ring_rows_) + ring_rows_) % ring_rows_;
-    float* out = ring_.data() + static_cast<size_t>(slot) * kChannels * w_;
-    if (ring_row_id_[slot] == s) return out;
-    ring_row_id_[slot] = s;
-    float* ix = deriv_.data();
-    float* iy = ix + w_;
-    float* it = iy + w_;
-    float* ub = it + w_;
-    float* vb = ub + w_;
-    switch (p_.derivative) {
-      case Derivative::HornSchunck:
-        // The 2x2x2 cube between rows s, s + 1 and columns x, x + 1: derivative grid at +1/2.
-        hs_derivatives(warped(s), warped(s + 1 < h_ ? s + 1 : s), w_, ix, iy, it, ub, vb);
-        break;
-      case Derivative::Scharr:
-      case Derivative::Central:
-        grid_derivatives(p_.derivative == Derivative::Scharr, warped(s - 1), warped(s),
-                         warped(s + 1), w_, ix, iy, it, ub, vb);
-        break;
-    }
-    if (p_.robust_inv_scale2 > 0.f) {
-      emit_products<true>(w_, ix, iy, it, ub, vb, p_.robust_inv_scale2, out);
-    } else {
-      emit_products<false>(w_, ix, iy, it, ub, vb, 0.f, out);
-    }
-    return out;
-  }
-
-  void add_row(const float* row, float sign) {
+  void resum_window(int y) {
+    std::fill(colsum_.begin(), colsum_.end(), 0.f);
     const size_t n = static_cast<size_t>(kChannels) * w_;
-    float* acc = colsum_.data();
-    if (sign > 0.f) {
+    float* __restrict acc = colsum_.data();
+    for (int s = y + p_.win.lo; s <= y + p_.win.hi; ++s) {
+      const float* __restrict row = ring_row(s);
       for (size_t i = 0; i < n; ++i)
         acc[i] += row[i];
-    } else {
-      for (size_t i = 0; i < n; ++i)
-        acc[i] -= row[i];
     }
   }
 
-  // Column sums of output row y, half-weight end rows removed, into the zero-padded col_.
-  void vertical_output(int y) {
-    const Window& win = p_.win;
-    for (int c = 0; c < kChannels; ++c) {
-      const float* src = colsum_.data() + static_cast<size_t>(c) * w_;
-      float* dst = col_.data() + static_cast<size_t>(c) * col_stride_ + hpad_lo_;
-      if (win.half) {
-        const float* top = products(y + win.lo) + static_cast<size_t>(c) * w_;
-        const float* bot = products(y + win.hi) + static_cast<size_t>(c) * w_;
-        for (int x = 0; x < w_; ++x)
-          dst[x] = src[x] - 0.5f * (top[x] + bot[x]);
+  // The ring holds the products of the derivative-grid rows in the vertical window.
+  float* ring_row(int s) {
+    const int slot = ((s % ring_rows_) + ring_rows_) % ring_rows_;
+    return ring_.data() + static_cast<size_t>(slot) * kChannels * w_;
+  }
+
+  // Brings derivative-grid row s (zero outside the rectangle) into the vertical window;
+  // with `leaving`, row s - ring_rows_ leaves it.
+  void advance(int s, bool leaving) {
+    float* row = ring_row(s);
+    float* acc = colsum_.data();
+    const float inv_s2 = p_.robust_inv_scale2;
+    if (s < 0 || s >= h_) {
+      const size_t n = static_cast<size_t>(kChannels) * w_;
+      for (size_t i = 0; i < n; ++i) {
+        if (leaving) acc[i] -= row[i];
+        row[i] = 0.f;
+      }
+      return;
+    }
+    // Horn–Schunck reads rows s, s + 1; the grid stencils s - 1, s, s + 1 (clamped).
+    const WarpedRow& up = warped(p_.derivative == Derivative::HornSchunck ? s : s - 1);
+    const WarpedRow& centre = warped(s);
+    const WarpedRow& down = warped(s + 1);
+    if (inv_s2 > 0.f) {
+      if (leaving) {
+        row_window_terms<true, true>(p_.derivative, up, centre, down, w_, inv_s2, row, acc);
       } else {
-        std::copy(src, src + w_, dst);
+        row_window_terms<true, false>(p_.derivative, up, centre, down, w_, inv_s2, row, acc);
       }
+    } else if (leaving) {
+      row_window_terms<false, true>(p_.derivative, up, centre, down, w_, inv_s2, row, acc);
+    } else {
+      row_window_terms<false, false>(p_.derivative, up, centre, down, w_, inv_s2, row, acc);
     }
   }
 
-  // Window sums along x as differences of a prefix sum: the prefix is the only serial part
-  // and runs eight lanes wide; the differences and half-weight corrections vectorise.
-  void horizontal_sums() {
+  // Column sums of output row y with the two end rows at weight 1/2, into the zero-padded
+  // col_ (the padding gives the horizontal half-weight correction its zeros off the edge).
+  void half_weight_ends(int y) {
     const Window& win = p_.win;
-    const int span = win.hi - win.lo;
-    const int n = w_ + span + 1;  // padded columns
-    float* prefix = delta_.data();
+    const float* top = ring_row(y + win.lo);
+    const float* bot = ring_row(y + win.hi);
     for (int c = 0; c < kChannels; ++c) {
-      // col[k] holds column k - hpad_lo_; the window of x covers col[x .. x + span].
-      const float* col = col_.data() + static_cast<size_t>(c) * col_stride_;
-      float* out = win_.data() + static_cast<size_t>(c) * w_;
-      inclusive_prefix(col, n, prefix + 1);
-      prefix[0] = 0.f;
+      const size_t o = static_cast<size_t>(c) * w_;
+      const float* __restrict src = colsum_.data() + o;
+      const float* __restrict t = top + o;
+      const float* __restrict b = bot + o;
+      float* __restrict dst = col_.data() + static_cast<size_t>(c) * col_stride_ + hpad_lo_;
       for (int x = 0; x < w_; ++x)
-        out[x] = prefix[x + span + 1] - prefix[x];
-      if (win.half) {
-        for (int x = 0; x < w_; ++x)
-          out[x] -= 0.5f * (col[x] + col[x + span]);
-      }
-    }
-  }
-
-  void solve_row(int y, float* u_new, float* v_new, float* confidence) {
-    const float* sxx = win_.data();
-    const float* sxy = sxx + w_;
-    const float* syy = sxy + w_;
-    const float inv_cy = 1.f / p_.cy[y];
-    const float* inv_cx = p_.inv_cx.data();
-    const int w = w_;
-    solve_pixels(w, win_.data(), inv_cx, inv_cy, p_.lambda, u_old_ + static_cast<size_t>(y) * w,
-                 v_old_ + static_cast<size_t>(y) * w, u_new, v_new);
-    if (confidence) {
-      for (int x = 0; x < w; ++x) {
-        const float n = inv_cx[x] * inv_cy;
-        const float gxx = sxx[x] * n, gxy = sxy[x] * n, gyy = syy[x] * n;
-        const float half_diff = 0.5f * (gxx - gyy);
-        confidence[x] =
-            std::max(0.f, 0.5f * (gxx + gyy) - std::sqrt(half_diff * half_diff + gxy * gxy));
-      }
+        dst[x] = src[x] - 0.5f * (t[x] + b[x]);
     }
   }
 
@@ -411,24 +536,19 @@ class RowIterator {
   RowScratch& scratch_ = thread_scratch();
   WarpedRow* warp_cache_ = scratch_.warp_cache;
   std::vector<float>& ring_ = scratch_.ring;
-  std::vector<int>& ring_row_id_ = scratch_.ring_row_id;
   std::vector<float>& colsum_ = scratch_.colsum;
   std::vector<float>& col_ = scratch_.col;
   int col_stride_ = 0;
   int hpad_lo_ = 0;
-  std::vector<float>& win_ = scratch_.win;
-  std::vector<float>& delta_ = scratch_.delta;
-  std::vector<float>& zero_row_ = scratch_.zero_row;
-  std::vector<float>& deriv_ = scratch_.deriv;
+  std::vector<float>& prefix_ = scratch_.prefix;
+  size_t prefix_stride_ = 0;
+  int prefix_pad_ = 0;
 };
 
-// Rows per stripe handed to the executor: each stripe re-primes its vertical window, so
-// stripes much shorter than the window would waste work.
-constexpr int kStripeRows = 32;
-
-void iterate_level(const LevelProblem& p, cv::Mat& u, cv::Mat& v, cv::Mat* confidence,
-                   int iterations, const Executor& executor) {
-  cv::Mat u_next(u.size(), CV_32F), v_next(v.size(), CV_32F);
+void iterate_level(const LevelProblem& p, cv::Mat& u, cv::Mat& v, cv::Mat& u_next, cv::Mat& v_next,
+                   cv::Mat* confidence, int iterations, const Executor& executor) {
+  u_next.create(u.size(), CV_32F);
+  v_next.create(v.size(), CV_32F);
   for (int it = 0; it < iterations; ++it) {
     const bool last = it + 1 == iterations;
     float* conf = (last && confidence) ? confidence->ptr<float>() : nullptr;
@@ -448,35 +568,72 @@ void iterate_level(const LevelProblem& p, cv::Mat& u, cv::Mat& v, cv::Mat* confi
 
 // Flow component of the coarser level (origin `src_origin` in its level) resampled onto
 // rectangle `dst` of the finer level and doubled. Pixel x of the finer level sits at x / 2 of
-// the coarser one, so the bilinear weights are 0, 1/2 or 1; borders replicate.
-cv::Mat upsample_flow(const cv::Mat& src, cv::Point src_origin, const cv::Rect& dst) {
-  auto taps = [](int fine, int origin, int n, int& i0, int& i1, float& f) {
-    const int twice = fine - 2 * origin;  // 2 * (fine / 2 - origin)
-    const int lo = twice >= 0 ? twice / 2 : -((-twice + 1) / 2);
-    f = (twice & 1) ? 0.5f : 0.f;
-    i0 = std::clamp(lo, 0, n - 1);
-    i1 = std::clamp(lo + 1, 0, n - 1);
-  };
-  std::vector<int> x0(dst.width), x1(dst.width);
-  std::vector<float> fx(dst.width), row(src.cols);
-  for (int x = 0; x < dst.width; ++x)
-    taps(dst.x + x, src_origin.x, src.cols, x0[x], x1[x], fx[x]);
-  cv::Mat out(dst.size(), CV_32F);
+// the coarser one, so along each axis the finer pixels alternate between copies of a coarse
+// pixel and means of two neighbours; borders replicate.
+void upsample_flow(const cv::Mat& src, cv::Point src_origin, const cv::Rect& dst, cv::Mat& out) {
+  const int n = src.cols;
+  // Coarse index of finer pixel 0 (floor of half of `twice`) and whether it falls between
+  // two coarse pixels. dst lies inside the coarse rectangle, so the index is >= 0.
+  const int twice_x = dst.x - 2 * src_origin.x;
+  const int k0 = twice_x >> 1;
+  const bool x_between = (twice_x & 1) != 0;
+  std::vector<float> copy(n + 2), mean(n + 2);
+  out.create(dst.size(), CV_32F);
   for (int y = 0; y < dst.height; ++y) {
-    int y0, y1;
-    float fy;
-    taps(dst.y + y, src_origin.y, src.rows, y0, y1, fy);
+    const int twice_y = dst.y + y - 2 * src_origin.y;
+    const int y0 = std::clamp(twice_y >> 1, 0, src.rows - 1);
+    const int y1 = std::min(y0 + 1, src.rows - 1);
+    const float fy = (twice_y & 1) ? 0.5f : 0.f;
     const float* a = src.ptr<float>(y0);
     const float* b = src.ptr<float>(y1);
-    for (int x = 0; x < src.cols; ++x)
-      row[x] = 2.f * (a[x] + fy * (b[x] - a[x]));
+    for (int x = 0; x < n; ++x)
+      copy[x] = 2.f * (a[x] + fy * (b[x] - a[x]));
+    copy[n] = copy[n + 1] = copy[n - 1];
+    for (int x = 0; x <= n; ++x)
+      mean[x] = 0.5f * (copy[x] + copy[x + 1]);
+    // Finer pixels alternate: even ones take `first`, odd ones `second`.
+    const float* first = x_between ? mean.data() + k0 : copy.data() + k0;
+    const float* second = x_between ? copy.data() + k0 + 1 : mean.data() + k0;
     float* o = out.ptr<float>(y);
-    for (int x = 0; x < dst.width; ++x) {
-      o[x] = row[x0[x]] + fx[x] * (row[x1[x]] - row[x0[x]]);
+    const int pairs = dst.width / 2;
+    for (int i = 0; i < pairs; ++i) {
+      o[2 * i] = first[i];
+      o[2 * i + 1] = second[i];
     }
+    if (dst.width & 1) o[dst.width - 1] = first[pairs];
   }
-  return out;
 }
+
+// Buffers of dense_flow kept per thread across calls: allocating them afresh (about 10 MB
+// for a VGA pair) costs page faults on every call. A nested call on the same thread (a TBB
+// worker that picks up another pair while it waits) gets a private workspace instead.
+struct Workspace {
+  bool busy = false;
+  Pyramid pyr_t, pyr_t1;
+  std::vector<cv::Mat> u, v, u_next, v_next;  // per level
+};
+
+class WorkspaceLease {
+ public:
+  WorkspaceLease() {
+    thread_local Workspace shared;
+    if (shared.busy) {
+      own_ = std::make_unique<Workspace>();
+      ws_ = own_.get();
+    } else {
+      ws_ = &shared;
+    }
+    ws_->busy = true;
+  }
+  ~WorkspaceLease() { ws_->busy = false; }
+  WorkspaceLease(const WorkspaceLease&) = delete;
+  WorkspaceLease& operator=(const WorkspaceLease&) = delete;
+  Workspace& operator*() const { return *ws_; }
+
+ private:
+  std::unique_ptr<Workspace> own_;
+  Workspace* ws_ = nullptr;
+};
 
 cv::Rect expand(const cv::Rect& r, int by) {
   return {r.x - by, r.y - by, r.width + 2 * by, r.height + 2 * by};
@@ -570,8 +727,11 @@ FlowResult dense_flow(const cv::Mat& frame_t, const cv::Mat& frame_t1, const LkP
                 std::to_string(frame_t.rows) + " vs " + std::to_string(frame_t1.cols) + "x" +
                 std::to_string(frame_t1.rows));
   }
-  return dense_flow(build_pyramid(frame_t, params.levels, params.sigma),
-                    build_pyramid(frame_t1, params.levels, params.sigma), params, options);
+  WorkspaceLease lease;
+  Workspace& ws = *lease;
+  build_pyramid(frame_t, params.levels, params.sigma, ws.pyr_t);
+  build_pyramid(frame_t1, params.levels, params.sigma, ws.pyr_t1);
+  return dense_flow(ws.pyr_t, ws.pyr_t1, params, options);
 }
 
 FlowResult dense_flow(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkParams& params,
@@ -610,16 +770,24 @@ FlowResult dense_flow(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkParam
   const SerialExecutor serial;
   const Executor& exec = options.executor ? *options.executor : serial;
 
-  cv::Mat u, v, confidence;
+  WorkspaceLease lease;
+  Workspace& ws = *lease;
+  for (auto* mats : {&ws.u, &ws.v, &ws.u_next, &ws.v_next})
+    mats->resize(levels);
+  cv::Mat confidence;
   for (int l = levels - 1; l >= 0; --l) {
     const cv::Rect& c = comp[l];
+    cv::Mat& u = ws.u[l];
+    cv::Mat& v = ws.v[l];
     if (l == levels - 1) {
       const float scale = 1.f / static_cast<float>(1 << l);
-      u = cv::Mat(c.size(), CV_32F, cv::Scalar(options.initial_motion.x * scale));
-      v = cv::Mat(c.size(), CV_32F, cv::Scalar(options.initial_motion.y * scale));
+      u.create(c.size(), CV_32F);
+      v.create(c.size(), CV_32F);
+      u.setTo(options.initial_motion.x * scale);
+      v.setTo(options.initial_motion.y * scale);
     } else {
-      u = upsample_flow(u, comp[l + 1].tl(), c);
-      v = upsample_flow(v, comp[l + 1].tl(), c);
+      upsample_flow(ws.u[l + 1], comp[l + 1].tl(), c, u);
+      upsample_flow(ws.v[l + 1], comp[l + 1].tl(), c, v);
     }
     LevelProblem p;
     p.i0 = &pyr_t.levels[l];
@@ -641,14 +809,15 @@ FlowResult dense_flow(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkParam
     for (int y = 0; y < c.height; ++y)
       p.cy[y] = window_weight(win, y, c.height);
     if (l == 0) confidence = cv::Mat(c.size(), CV_32F);
-    iterate_level(p, u, v, l == 0 ? &confidence : nullptr, params.iterations, exec);
+    iterate_level(p, u, v, ws.u_next[l], ws.v_next[l], l == 0 ? &confidence : nullptr,
+                  params.iterations, exec);
     if (l > 0) median_filter(u, v, params.level_median);
   }
-  median_filter(u, v, params.final_median);
+  median_filter(ws.u[0], ws.v[0], params.final_median);
 
   const cv::Rect crop(region.tl() - comp[0].tl(), region.size());
   FlowResult result;
-  cv::merge(std::vector<cv::Mat>{u(crop), v(crop)}, result.flow);
+  cv::merge(std::vector<cv::Mat>{ws.u[0](crop), ws.v[0](crop)}, result.flow);
   result.confidence = confidence(crop).clone();
   result.region = region;
   return result;

@@ -26,8 +26,7 @@ int effective_levels(cv::Size size, int requested) {
 
 namespace {
 
-cv::Mat to_unit_float(const cv::Mat& image) {
-  cv::Mat out;
+void to_unit_float(const cv::Mat& image, cv::Mat& out) {
   switch (image.type()) {
     case CV_8UC1:
       image.convertTo(out, CV_32F, 1.0 / 255.0);
@@ -42,33 +41,33 @@ cv::Mat to_unit_float(const cv::Mat& image) {
       image.convertTo(out, CV_32F, 1.0 / 65535.0);
       break;
     case CV_32FC1:
-      out = image.clone();
+      image.copyTo(out);
       break;
     default:
       throw Error("image type must be 8-bit gray, 8-bit BGR, 16-bit gray or float gray, got " +
                   cv::typeToString(image.type()));
   }
-  return out;
 }
 
 }  // namespace
 
-Pyramid build_pyramid(const cv::Mat& image, int levels, double sigma) {
+void build_pyramid(const cv::Mat& image, int levels, double sigma, Pyramid& out) {
   if (image.empty()) throw Error("image is empty");
   if (!(sigma >= 0.0 && sigma <= 20.0)) {
     throw Error("smoothing sigma must be in [0, 20], got " + std::to_string(sigma));
   }
   const int n = effective_levels(image.size(), levels);
-  Pyramid pyr;
-  pyr.levels.reserve(n);
-  cv::Mat base = to_unit_float(image);
+  out.levels.resize(n);
+  cv::Mat& base = out.levels[0];
+  to_unit_float(image, base);
   if (sigma > 0.0) cv::GaussianBlur(base, base, cv::Size(), sigma, sigma, cv::BORDER_REPLICATE);
-  pyr.levels.push_back(base);
-  for (int l = 1; l < n; ++l) {
-    cv::Mat down;
-    cv::pyrDown(pyr.levels.back(), down);
-    pyr.levels.push_back(down);
-  }
+  for (int l = 1; l < n; ++l)
+    cv::pyrDown(out.levels[l - 1], out.levels[l]);
+}
+
+Pyramid build_pyramid(const cv::Mat& image, int levels, double sigma) {
+  Pyramid pyr;
+  build_pyramid(image, levels, sigma, pyr);
   return pyr;
 }
 

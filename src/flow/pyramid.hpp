@@ -31,5 +31,8 @@ int effective_levels(cv::Size size, int requested);
 // Accepts CV_8UC1, CV_8UC3 (BGR, converted to gray), CV_16UC1 and CV_32FC1 (taken as [0, 1]).
 // Throws roiflow::Error on an empty image, another type, or sigma < 0 or > 20.
 Pyramid build_pyramid(const cv::Mat& image, int levels, double sigma);
+// The same into `out`, reusing its buffers when the sizes match (one pyramid per video frame
+// without an allocation per frame). `out` must not share buffers with `image`.
+void build_pyramid(const cv::Mat& image, int levels, double sigma, Pyramid& out);
 
 }  // namespace roiflow::flow
