@@ -1,0 +1,449 @@
+// roiflow — the command-line tool, one git-style subcommand per job.
+//
+//   roiflow flow --synthetic -o out.flo --color out.png
+//   roiflow flow A.png B.png -o out.flo --gt truth.flo
+//   roiflow eval data/middlebury --format csv -o errors.csv
+//
+// Each subcommand is a thin layer: CLI11 parses, the library computes, this file prints.
+// Failures print one line, `roiflow: error: <message>`, on stderr: exit code 2 for a bad
+// command line (including out-of-range LK parameters), 1 for anything that fails at run time.
+// Inputs and output locations are checked before any computation, and every output is written
+// atomically, so a failed run leaves no file behind.
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <opencv2/imgcodecs.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "flow/color_code.hpp"
+#include "flow/dense_lk.hpp"
+#include "flow/error.hpp"
+#include "flow/flo_io.hpp"
+#include "flow/metrics.hpp"
+#include "flow/pyramid.hpp"
+#include "flow/synthetic.hpp"
+#include "pipeline/tbb_executor.hpp"
+#include "stages/flow_eval.hpp"
+
+namespace {
+
+using namespace roiflow;
+namespace fs = std::filesystem;
+
+// A command line that CLI11 accepts but that makes no sense (conflicting inputs, LK
+// parameters out of range): reported like CLI11's own parse errors, with exit code 2.
+class UsageError : public Error {
+ public:
+  using Error::Error;
+};
+
+const cv::Size kSyntheticSize{640, 480};
+constexpr flow::SceneKind kSceneKinds[] = {flow::SceneKind::Translation, flow::SceneKind::Rotation,
+                                           flow::SceneKind::Zoom, flow::SceneKind::NonRigid,
+                                           flow::SceneKind::MovingObject};
+
+// ---------------------------------------------------------------------------------------------
+// Shared Lucas-Kanade options
+
+// Overrides stay empty unless given, so they apply on top of whichever preset was chosen.
+struct LkOptions {
+  std::string preset = "paper";
+  std::optional<int> patch, levels, iterations, level_median, final_median;
+  std::optional<double> sigma, lambda, robust_scale;
+  std::optional<std::string> derivative;
+  int threads = 1;
+};
+
+void add_lk_options(CLI::App& cmd, LkOptions& lk) {
+  const std::string group = "Lucas-Kanade parameters (default: the preset's)";
+  cmd.add_option("--preset", lk.preset, "parameter set the options below override")
+      ->type_name("NAME")
+      ->check(CLI::IsMember(flow::LkParams::preset_names()))
+      ->capture_default_str()
+      ->group(group);
+  cmd.add_option("--patch", lk.patch, "window side in pixels")
+      ->check(CLI::Range(3, 31))
+      ->group(group);
+  cmd.add_option("--levels", lk.levels, "pyramid levels")
+      ->check(CLI::Range(1, flow::kMaxLevels))
+      ->group(group);
+  cmd.add_option("--iterations", lk.iterations, "refinement iterations per level")
+      ->check(CLI::Range(1, 50))
+      ->group(group);
+  cmd.add_option("--sigma", lk.sigma, "pretreatment Gaussian sigma in pixels, 0..20 (0 = off)")
+      ->group(group);
+  cmd.add_option("--lambda", lk.lambda, "Tikhonov weight, (0, 1]")->group(group);
+  cmd.add_option("--derivative", lk.derivative, "image derivatives")
+      ->type_name("NAME")
+      ->check(CLI::IsMember({"hs", "scharr", "central"}))
+      ->group(group);
+  cmd.add_option("--robust-scale", lk.robust_scale,
+                 "Cauchy reweighting scale of the residuals, 0..1 (0 = plain least squares)")
+      ->group(group);
+  cmd.add_option("--level-median", lk.level_median,
+                 "median filter of the flow after each coarse level (0 = off)")
+      ->check(CLI::IsMember({0, 3, 5}))
+      ->group(group);
+  cmd.add_option("--final-median", lk.final_median, "median filter of the final flow (0 = off)")
+      ->check(CLI::IsMember({0, 3, 5}))
+      ->group(group);
+  cmd.add_option("--threads", lk.threads, "worker threads")
+      ->check(CLI::Range(1, pipeline::kMaxThreads))
+      ->capture_default_str()
+      ->group(group);
+}
+
+flow::LkParams lk_params(const LkOptions& lk) {
+  flow::LkParams params = flow::LkParams::preset(lk.preset);
+  if (lk.patch) params.patch = *lk.patch;
+  if (lk.levels) params.levels = *lk.levels;
+  if (lk.iterations) params.iterations = *lk.iterations;
+  if (lk.sigma) params.sigma = *lk.sigma;
+  if (lk.lambda) params.lambda = *lk.lambda;
+  if (lk.derivative) params.derivative = flow::derivative_from_string(*lk.derivative);
+  if (lk.robust_scale) params.robust_scale = *lk.robust_scale;
+  if (lk.level_median) params.level_median = *lk.level_median;
+  if (lk.final_median) params.final_median = *lk.final_median;
+  try {
+    params.validate();
+  } catch (const Error& e) {
+    throw UsageError(e.what());
+  }
+  return params;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Output helpers
+
+std::string size_string(cv::Size size) {
+  return std::to_string(size.width) + "x" + std::to_string(size.height);
+}
+
+std::string fixed(double value, int decimals) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
+  return buffer;
+}
+
+std::string errors_line(const flow::FlowErrors& e) {
+  return "AAE " + fixed(e.aae_deg, 3) + " deg, EPE " + fixed(e.epe, 4) + " px, R1 " +
+         fixed(e.r1, 2) + " %, R3 " + fixed(e.r3, 2) + " %";
+}
+
+// Catches a mistyped output path before minutes of computation are spent.
+void check_output_path(const std::string& path, const std::string& option) {
+  const fs::path parent = fs::path(path).parent_path();
+  std::error_code ec;
+  if (!parent.empty() && !fs::is_directory(parent, ec)) {
+    throw Error(option + ": directory '" + parent.string() + "' of '" + path + "' does not exist");
+  }
+  if (fs::is_directory(path, ec)) throw Error(option + ": '" + path + "' is a directory");
+}
+
+void check_image_output(const std::string& path, const std::string& option) {
+  check_output_path(path, option);
+  if (!cv::haveImageWriter(path)) {
+    throw UsageError(option + ": cannot write an image named '" + path +
+                     "' (use an extension such as .png)");
+  }
+}
+
+// The partial file keeps the extension, from which cv::imwrite picks the format.
+fs::path partial_path(const fs::path& path) {
+  fs::path partial = path;
+  partial.replace_filename("." + path.stem().string() + ".partial" + path.extension().string());
+  return partial;
+}
+
+// Written next to the target, then renamed over it: a reader never sees half a file.
+void write_image(const std::string& path, const cv::Mat& image) {
+  const fs::path partial = partial_path(path);
+  bool written = false;
+  try {
+    written = cv::imwrite(partial.string(), image);
+  } catch (const cv::Exception&) {
+    written = false;
+  }
+  std::error_code ec;
+  if (written) fs::rename(partial, path, ec);
+  if (!written || ec) {
+    fs::remove(partial, ec);
+    throw Error("cannot write image '" + path + "'");
+  }
+}
+
+void write_text(const std::string& path, const std::string& text) {
+  const fs::path partial = partial_path(path);
+  std::ofstream out(partial, std::ios::binary);
+  out << text;
+  out.close();
+  std::error_code ec;
+  if (out) fs::rename(partial, path, ec);
+  if (!out || ec) {
+    fs::remove(partial, ec);
+    throw Error("cannot write '" + path + "'");
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// roiflow flow
+
+struct FlowCommand {
+  LkOptions lk;
+  std::string frame0;
+  std::string frame1;
+  std::string scene;  // set by --synthetic
+  std::string output;
+  std::string color;
+  std::string legend;
+  std::string ground_truth;
+};
+
+flow::SceneKind scene_kind(const std::string& name) {
+  for (flow::SceneKind kind : kSceneKinds) {
+    if (name == flow::to_string(kind)) return kind;
+  }
+  throw UsageError("unknown synthetic scene '" + name + "'");
+}
+
+void run_flow(const FlowCommand& cmd) {
+  const flow::LkParams params = lk_params(cmd.lk);
+  const bool synthetic = !cmd.scene.empty();
+  if (synthetic && !cmd.frame0.empty()) {
+    throw UsageError("give either two images A B or --synthetic, not both");
+  }
+  if (synthetic && !cmd.ground_truth.empty()) {
+    throw UsageError("--gt: a --synthetic scene brings its own ground truth");
+  }
+  if (!synthetic && cmd.frame1.empty()) {
+    throw UsageError("flow needs two images A B, or --synthetic [scene]");
+  }
+  check_output_path(cmd.output, "-o");
+  if (!cmd.color.empty()) check_image_output(cmd.color, "--color");
+  if (!cmd.legend.empty()) check_image_output(cmd.legend, "--legend");
+
+  cv::Mat frame0, frame1, truth;
+  std::string source;
+  if (synthetic) {
+    flow::Scene scene = flow::make_scene(scene_kind(cmd.scene), kSyntheticSize);
+    frame0 = scene.frame0;
+    frame1 = scene.frame1;
+    truth = scene.flow;
+    source = "synthetic " + cmd.scene;
+  } else {
+    frame0 = stages::read_gray(cmd.frame0);
+    frame1 = stages::read_gray(cmd.frame1);
+    if (frame0.size() != frame1.size()) {
+      throw Error("'" + cmd.frame0 + "' is " + size_string(frame0.size()) + " but '" + cmd.frame1 +
+                  "' is " + size_string(frame1.size()));
+    }
+    if (!cmd.ground_truth.empty()) {
+      truth = flow::read_flo(cmd.ground_truth);
+      if (truth.size() != frame0.size()) {
+        throw Error("--gt: '" + cmd.ground_truth + "' is " + size_string(truth.size()) + " but '" +
+                    cmd.frame0 + "' is " + size_string(frame0.size()));
+      }
+    }
+    source = cmd.frame0 + " -> " + cmd.frame1;
+  }
+
+  const pipeline::TbbExecutor executor;
+  flow::FlowOptions options;
+  options.executor = &executor;
+  const auto start = std::chrono::steady_clock::now();
+  const flow::FlowResult result = pipeline::run_with_threads(
+      cmd.lk.threads, [&] { return flow::dense_flow(frame0, frame1, params, options); });
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  // Scored before writing so that a failure here leaves no output behind.
+  std::optional<flow::FlowErrors> errors;
+  if (!truth.empty()) {
+    errors = flow::flow_errors(result.flow, truth);
+    if (errors->pixels == 0) throw Error("--gt: '" + cmd.ground_truth + "' is unknown everywhere");
+  }
+
+  std::string written = cmd.output;
+  flow::write_flo(cmd.output, result.flow);
+  if (!cmd.color.empty()) {
+    write_image(cmd.color, flow::flow_to_color(result.flow));
+    written += ", " + cmd.color;
+  }
+  if (!cmd.legend.empty()) {
+    write_image(cmd.legend, flow::color_wheel_legend());
+    written += ", " + cmd.legend;
+  }
+
+  std::cout << "flow " << size_string(frame0.size()) << " (" << source << "): " << fixed(ms, 2)
+            << " ms, wrote " << written << "\n";
+  if (errors) std::cout << "error vs ground truth: " << errors_line(*errors) << "\n";
+}
+
+void add_flow_command(CLI::App& app, FlowCommand& cmd) {
+  CLI::App* sub = app.add_subcommand(
+      "flow", "Dense flow of one image pair (or a built-in synthetic pair) to a .flo file");
+  sub->add_option("A", cmd.frame0, "frame t (read as 8-bit gray)")->type_name("IMAGE");
+  sub->add_option("B", cmd.frame1, "frame t+1")->type_name("IMAGE");
+  std::vector<std::string> scenes;
+  for (flow::SceneKind kind : kSceneKinds)
+    scenes.emplace_back(flow::to_string(kind));
+  sub->add_option("--synthetic", cmd.scene,
+                  "use a built-in " + size_string(kSyntheticSize) +
+                      " pair with exact ground truth instead of A B, and print the error")
+      ->type_name("SCENE")
+      ->expected(0, 1)
+      ->default_str(flow::to_string(flow::SceneKind::MovingObject))
+      ->check(CLI::IsMember(scenes));
+  sub->add_option("-o,--output", cmd.output, "the flow, Middlebury .flo")
+      ->type_name("FLO")
+      ->required();
+  sub->add_option("--color", cmd.color, "the flow in Middlebury colour coding")->type_name("IMAGE");
+  sub->add_option("--legend", cmd.legend, "the colour wheel, as a legend")->type_name("IMAGE");
+  sub->add_option("--gt", cmd.ground_truth, "ground-truth flow: print the error against it")
+      ->type_name("FLO");
+  add_lk_options(*sub, cmd.lk);
+  sub->callback([&cmd] { run_flow(cmd); });
+}
+
+// ---------------------------------------------------------------------------------------------
+// roiflow eval
+
+struct EvalCommand {
+  LkOptions lk;
+  std::string dir;
+  std::vector<std::vector<std::string>> pairs;  // A, B, ground truth
+  std::vector<std::string> exclude_masks;
+  std::string format = "table";
+  std::string output;
+};
+
+std::vector<stages::EvalPair> eval_pairs(const EvalCommand& cmd) {
+  if (cmd.dir.empty() && cmd.pairs.empty()) {
+    throw UsageError("eval needs a Middlebury directory DIR or at least one --pair A B GT");
+  }
+  if (!cmd.dir.empty()) return stages::find_middlebury(cmd.dir);
+  if (!cmd.exclude_masks.empty() && cmd.exclude_masks.size() != cmd.pairs.size()) {
+    throw UsageError("--exclude-mask: got " + std::to_string(cmd.exclude_masks.size()) +
+                     " masks for " + std::to_string(cmd.pairs.size()) +
+                     " pairs (give one per --pair, in the same order)");
+  }
+  std::vector<stages::EvalPair> pairs;
+  for (std::size_t i = 0; i < cmd.pairs.size(); ++i) {
+    const std::vector<std::string>& p = cmd.pairs[i];
+    pairs.push_back({"pair" + std::to_string(i + 1), p.at(0), p.at(1), p.at(2),
+                     cmd.exclude_masks.empty() ? "" : cmd.exclude_masks[i]});
+  }
+  return pairs;
+}
+
+void run_eval(const EvalCommand& cmd) {
+  const flow::LkParams params = lk_params(cmd.lk);
+  const std::vector<stages::EvalPair> pairs = eval_pairs(cmd);
+  if (!cmd.output.empty()) check_output_path(cmd.output, "-o");
+
+  const pipeline::TbbExecutor executor;
+  std::vector<stages::EvalRow> rows;
+  pipeline::run_with_threads(cmd.lk.threads, [&] {
+    for (const stages::EvalPair& pair : pairs)
+      rows.push_back(stages::evaluate_pair(pair, params, &executor));
+  });
+
+  std::string text;
+  if (cmd.format == "csv") {
+    text = stages::format_csv(rows);
+  } else if (cmd.format == "json") {
+    text = stages::format_json(rows, cmd.lk.preset, params);
+  } else {
+    text = stages::format_table(rows);
+  }
+  if (cmd.output.empty()) {
+    std::cout << text;
+  } else {
+    write_text(cmd.output, text);
+    std::cout << "evaluated " << rows.size() << " pairs, wrote " << cmd.output << "\n";
+  }
+}
+
+void add_eval_command(CLI::App& app, EvalCommand& cmd) {
+  CLI::App* sub = app.add_subcommand(
+      "eval", "Dense flow error (AAE, EPE, R1, R3) and time over pairs with ground truth");
+  CLI::Option* dir =
+      sub->add_option(
+             "DIR", cmd.dir,
+             "Middlebury tree: DIR/<seq>/frame10.png, frame11.png, flow10.flo (gray/ preferred)")
+          ->type_name("DIR");
+  CLI::Option* pair = sub->add_option("--pair", cmd.pairs, "an image pair and its .flo; repeatable")
+                          ->type_name("A B GT")
+                          ->type_size(3)
+                          ->allow_extra_args(false);
+  sub->add_option("--exclude-mask", cmd.exclude_masks,
+                  "pixels not scored (non-zero) for each --pair, in the same order")
+      ->type_name("IMAGE")
+      ->needs(pair);
+  dir->excludes(pair);
+  sub->add_option("--format", cmd.format, "output format")
+      ->type_name("FORMAT")
+      ->check(CLI::IsMember({"table", "csv", "json"}))
+      ->capture_default_str();
+  sub->add_option("-o,--output", cmd.output, "write the results to FILE instead of stdout")
+      ->type_name("FILE");
+  add_lk_options(*sub, cmd.lk);
+  sub->callback([&cmd] { run_eval(cmd); });
+}
+
+// ---------------------------------------------------------------------------------------------
+
+// OpenCV's messages span lines; the CLI promises one.
+std::string one_line(std::string text) {
+  for (char& c : text) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  while (!text.empty() && text.back() == ' ')
+    text.pop_back();
+  return text;
+}
+
+int report(const std::string& message, int exit_code) {
+  std::cerr << "roiflow: error: " << one_line(message) << "\n";
+  return exit_code;
+}
+
+// Points at the help of the subcommand the user was typing, when CLI11 got that far.
+int report_usage(const CLI::App& app, const std::string& message) {
+  std::string command = "roiflow";
+  for (const CLI::App* sub : app.get_subcommands())
+    command += " " + sub->get_name();
+  return report(message + " (see '" + command + " --help')", 2);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"roiflow: realtime dense and local Lucas-Kanade optical flow", "roiflow"};
+  app.require_subcommand(1);
+  FlowCommand flow_cmd;
+  EvalCommand eval_cmd;
+  add_flow_command(app, flow_cmd);
+  add_eval_command(app, eval_cmd);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help and --help-all are "errors" with exit code 0 that print the help.
+    if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);
+    return report_usage(app, e.what());
+  } catch (const UsageError& e) {
+    return report_usage(app, e.what());
+  } catch (const cv::Exception& e) {
+    return report("OpenCV: " + e.err, 1);
+  } catch (const std::exception& e) {
+    return report(e.what(), 1);
+  } catch (...) {
+    return report("unexpected failure", 1);
+  }
+  return 0;
+}

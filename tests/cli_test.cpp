@@ -1,0 +1,278 @@
+// End-to-end tests of the roiflow binary: exit codes, stdout, the one-line error contract and
+// the files it leaves behind.
+#include <gtest/gtest.h>
+#include <stdlib.h>
+#include <sys/wait.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "flow/flo_io.hpp"
+#include "flow/synthetic.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace roiflow;
+
+struct CliResult {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+std::vector<std::string> split(const std::string& text, char separator) {
+  std::vector<std::string> parts;
+  std::istringstream in(text);
+  for (std::string part; std::getline(in, part, separator);)
+    parts.push_back(part);
+  return parts;
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+  return split(text, '\n');
+}
+
+// Appends ` 'arg'` to a shell command line.
+void append_quoted(std::string& command, const std::string& arg) {
+  command += " '";
+  for (char c : arg) {
+    if (c == '\'') {
+      command += "'\\''";
+    } else {
+      command += c;
+    }
+  }
+  command += '\'';
+}
+
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string pattern = (fs::temp_directory_path() / "roiflow_cli_XXXXXX").string();
+    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
+    dir_ = pattern;
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string path(const std::string& relative) const { return (dir_ / relative).string(); }
+
+  CliResult run(const std::vector<std::string>& args) const {
+    std::string command;
+    append_quoted(command, ROIFLOW_CLI_PATH);
+    for (const std::string& arg : args)
+      append_quoted(command, arg);
+    command += " >";
+    append_quoted(command, path("stdout.txt"));
+    command += " 2>";
+    append_quoted(command, path("stderr.txt"));
+    const int status = std::system(command.c_str());
+    CliResult result;
+    result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    result.out = read_text(path("stdout.txt"));
+    result.err = read_text(path("stderr.txt"));
+    return result;
+  }
+
+  void write_image(const std::string& relative, const cv::Mat& image) const {
+    fs::create_directories(fs::path(path(relative)).parent_path());
+    ASSERT_TRUE(cv::imwrite(path(relative), image));
+  }
+
+  // DIR/<name>/frame10.png, frame11.png, flow10.flo of a small synthetic translation.
+  void write_sequence(const std::string& tree, const std::string& name) const {
+    const flow::Scene scene = flow::make_translation({96, 64}, {1.3f, -0.7f});
+    write_image(tree + "/" + name + "/frame10.png", scene.frame0);
+    write_image(tree + "/" + name + "/frame11.png", scene.frame1);
+    flow::write_flo(path(tree + "/" + name + "/flow10.flo"), scene.flow);
+  }
+
+  fs::path dir_;
+};
+
+// Every failure: non-zero exit, one line on stderr in the CLI's format, nothing on stdout.
+void expect_one_line_error(const CliResult& r, int exit_code) {
+  EXPECT_EQ(r.exit_code, exit_code) << r.err;
+  const std::vector<std::string> lines = lines_of(r.err);
+  ASSERT_EQ(lines.size(), 1u) << r.err;
+  EXPECT_EQ(lines[0].rfind("roiflow: error: ", 0), 0u) << lines[0];
+  EXPECT_TRUE(r.out.empty()) << r.out;
+}
+
+TEST_F(CliTest, FlowSyntheticWritesReadableFlowAndColour) {
+  const CliResult r = run({"flow", "--synthetic", "-o", path("out.flo"), "--color", path("out.png"),
+                           "--legend", path("legend.png")});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+
+  const cv::Mat flow = flow::read_flo(path("out.flo"));
+  EXPECT_EQ(flow.size(), cv::Size(640, 480));
+  const cv::Mat color = cv::imread(path("out.png"), cv::IMREAD_UNCHANGED);
+  EXPECT_EQ(color.size(), cv::Size(640, 480));
+  EXPECT_EQ(color.channels(), 3);
+  EXPECT_FALSE(cv::imread(path("legend.png")).empty());
+
+  const std::size_t epe = r.out.find("EPE ");
+  ASSERT_NE(epe, std::string::npos) << r.out;
+  EXPECT_LT(std::stod(r.out.substr(epe + 4)), 0.15) << r.out;  // 0.07 at the time of writing
+  for (const char* metric : {"AAE", "R1", "R3"})
+    EXPECT_NE(r.out.find(metric), std::string::npos);
+  EXPECT_EQ(lines_of(r.out).size(), 2u) << r.out;
+}
+
+TEST_F(CliTest, FlowOnImageFilesScoresAgainstGroundTruth) {
+  const flow::Scene scene = flow::make_scene(flow::SceneKind::Translation, {128, 96});
+  write_image("a.png", scene.frame0);
+  write_image("b.png", scene.frame1);
+  flow::write_flo(path("gt.flo"), scene.flow);
+  const CliResult r = run({"flow", path("a.png"), path("b.png"), "-o", path("out.flo"), "--gt",
+                           path("gt.flo"), "--preset", "accurate", "--patch", "9"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("128x96"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("EPE"), std::string::npos) << r.out;
+  EXPECT_EQ(flow::read_flo(path("out.flo")).size(), cv::Size(128, 96));
+}
+
+TEST_F(CliTest, EvalCsvOverMiddleburyTree) {
+  write_sequence("mb", "Venus");
+  write_sequence("mb", "Dimetrodon");
+  const CliResult r = run({"eval", path("mb"), "--format", "csv"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::vector<std::string> lines = lines_of(r.out);
+  ASSERT_EQ(lines.size(), 4u) << r.out;
+  EXPECT_EQ(lines[0], "sequence,aae_deg,epe,r1,r3,ms");
+  EXPECT_EQ(lines[1].rfind("Dimetrodon,", 0), 0u);
+  EXPECT_EQ(lines[2].rfind("Venus,", 0), 0u);
+  EXPECT_EQ(lines[3].rfind("mean,", 0), 0u);
+  // mean,<aae .3f>,<epe .4f>,<r1 .2f>,<r3 .2f>,<ms .2f>
+  const std::vector<std::string> fields = split(lines[3], ',');
+  ASSERT_EQ(fields.size(), 6u) << lines[3];
+  const int decimals[] = {3, 4, 2, 2, 2};
+  for (int i = 0; i < 5; ++i) {
+    const std::string& field = fields[i + 1];
+    ASSERT_NE(field.find('.'), std::string::npos) << field;
+    EXPECT_EQ(static_cast<int>(field.size() - field.find('.') - 1), decimals[i]) << field;
+    EXPECT_GE(std::stod(field), 0.0) << field;
+  }
+
+  const CliResult to_file = run({"eval", path("mb"), "--format", "json", "-o", path("e.json")});
+  ASSERT_EQ(to_file.exit_code, 0) << to_file.err;
+  const nlohmann::json doc = nlohmann::json::parse(read_text(path("e.json")));
+  EXPECT_EQ(doc["preset"], "paper");
+  EXPECT_EQ(doc["rows"].size(), 2u);
+  EXPECT_EQ(doc["mean"]["sequence"], "mean");
+
+  const CliResult table = run({"eval", path("mb")});
+  ASSERT_EQ(table.exit_code, 0) << table.err;
+  EXPECT_EQ(table.out.rfind("sequence", 0), 0u) << table.out;
+  EXPECT_NE(table.out.find("\nmean"), std::string::npos) << table.out;
+}
+
+TEST_F(CliTest, EvalPairsWithExcludeMasks) {
+  write_sequence("mb", "One");
+  write_sequence("mb", "Two");
+  write_image("mask.png", cv::Mat(64, 96, CV_8UC1, cv::Scalar(0)));
+  const CliResult r =
+      run({"eval", "--format", "csv", "--pair", path("mb/One/frame10.png"),
+           path("mb/One/frame11.png"), path("mb/One/flow10.flo"), "--pair",
+           path("mb/Two/frame10.png"), path("mb/Two/frame11.png"), path("mb/Two/flow10.flo"),
+           "--exclude-mask", path("mask.png"), "--exclude-mask", path("mask.png")});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::vector<std::string> lines = lines_of(r.out);
+  ASSERT_EQ(lines.size(), 4u) << r.out;
+  EXPECT_EQ(lines[1].rfind("pair1,", 0), 0u);
+  EXPECT_EQ(lines[2].rfind("pair2,", 0), 0u);
+}
+
+TEST_F(CliTest, HelpExitsZero) {
+  for (const char* sub : {"flow", "eval"}) {
+    const CliResult r = run({sub, "--help"});
+    EXPECT_EQ(r.exit_code, 0) << sub;
+    EXPECT_NE(r.out.find("--preset"), std::string::npos) << r.out;
+  }
+}
+
+TEST_F(CliTest, BadInputsFailWithOneLineAndNoOutput) {
+  write_sequence("corrupt", "Venus");
+  std::ofstream(path("corrupt/Venus/flow10.flo"), std::ios::binary) << "PIEH? no: bad magic";
+  write_sequence("mb", "Venus");
+  write_image("small.png", cv::Mat(32, 48, CV_8UC1, cv::Scalar(9)));
+  const std::string flo = path("out.flo");
+  const std::string png = path("out.png");
+  const std::string csv = path("out.csv");
+  const std::vector<std::string> synthetic = {"flow", "--synthetic", "-o", flo, "--color", png};
+  const auto with = [&](std::vector<std::string> args, const std::vector<std::string>& more) {
+    args.insert(args.end(), more.begin(), more.end());
+    return args;
+  };
+  struct Case {
+    std::vector<std::string> args;
+    int exit_code;
+  };
+  const std::vector<Case> cases = {
+      {{}, 2},
+      {{"nonsense"}, 2},
+      {{"flow", path("missing.png"), path("mb/Venus/frame11.png"), "-o", flo}, 1},
+      {{"flow", path("mb/Venus/frame10.png"), path("small.png"), "-o", flo}, 1},
+      {{"flow", path("mb/Venus/frame10.png"), "-o", flo}, 2},
+      {{"flow", path("mb/Venus/frame10.png"), path("mb/Venus/frame11.png"), "-o", flo, "--gt",
+        path("corrupt/Venus/flow10.flo")},
+       1},
+      {with(synthetic, {"--patch", "1"}), 2},
+      {with(synthetic, {"--patch", "40"}), 2},
+      {with(synthetic, {"--levels", "0"}), 2},
+      {with(synthetic, {"--preset", "nope"}), 2},
+      {with(synthetic, {"--sigma", "-1"}), 2},
+      {with(synthetic, {"--lambda", "0"}), 2},
+      {with(synthetic, {"--derivative", "sobel"}), 2},
+      {with(synthetic, {"--final-median", "4"}), 2},
+      {with(synthetic, {"--threads", "0"}), 2},
+      {{"flow", "--synthetic", "nope", "-o", flo}, 2},
+      {{"flow", "--synthetic", "-o", flo, "--color", path("out.xyz")}, 2},
+      {{"flow", "--synthetic", "-o", path("no/such/dir/out.flo")}, 1},
+      {{"flow", "--synthetic", "-o", dir_.string()}, 1},
+      {{"flow", path("mb/Venus/frame10.png"), path("mb/Venus/frame11.png"), "-o", flo,
+        "--synthetic"},
+       2},
+      {{"flow", "--synthetic", "-o", flo, "--color", path("no/such/dir/out.png")}, 1},
+      {{"eval", path("corrupt"), "--format", "csv", "-o", csv}, 1},
+      {{"eval", path("missing"), "-o", csv}, 1},
+      {{"eval", "-o", csv}, 2},
+      {{"eval", path("mb"), "--pair", "a.png", "b.png", "gt.flo", "-o", csv}, 2},
+      {{"eval", "--pair", "a.png", "b.png"}, 2},
+      {{"eval", "--pair", "a.png", "b.png", "gt.flo", "--exclude-mask", "m1.png", "--exclude-mask",
+        "m2.png"},
+       2},
+      {{"eval", path("mb"), "--format", "xml", "-o", csv}, 2},
+  };
+  for (const Case& c : cases) {
+    std::string shown;
+    for (const std::string& arg : c.args)
+      shown += " " + arg;
+    SCOPED_TRACE("roiflow" + shown);
+    expect_one_line_error(run(c.args), c.exit_code);
+    EXPECT_FALSE(fs::exists(flo));
+    EXPECT_FALSE(fs::exists(png));
+    EXPECT_FALSE(fs::exists(csv));
+  }
+  // No partial files either: the directory holds only what the test wrote.
+  for (const fs::directory_entry& entry : fs::directory_iterator(dir_)) {
+    const std::string name = entry.path().filename().string();
+    EXPECT_TRUE(name == "corrupt" || name == "mb" || name == "small.png" || name == "stdout.txt" ||
+                name == "stderr.txt")
+        << name;
+  }
+}
+
+}  // namespace
