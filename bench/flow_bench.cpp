@@ -5,7 +5,10 @@
 //
 //   BM_Flow/<method>/<W>x<H>/threads:<n>   method: roiflow_paper, roiflow_accurate,
 //                                          dis_ultrafast, dis_fast, dis_medium, farneback
-//   BM_Pyramid/<W>x<H>                     build_pyramid(frame, 3, 1.0) alone, one thread
+//   BM_Pyramid/<W>x<H>                     build_pyramid(frame) alone (paper preset), 1 thread
+//   BM_Middlebury/<method>/threads:1       with ROIFLOW_MIDDLEBURY=DIR set: every sequence of
+//                                          that Middlebury tree per iteration; counters EPE and
+//                                          AAE are the means over sequences, ms_per_pair the time
 //
 // Every benchmark runs inside run_with_threads(n): n arena slots for roiflow's stripes and
 // cv::setNumThreads(n) for OpenCV's own loops (DIS, Farneback, and the remap/pyrDown roiflow
@@ -15,7 +18,9 @@
 // timing loop. Frames: make_scene(MovingObject), built once per size on first use.
 #include <benchmark/benchmark.h>
 
+#include <chrono>
 #include <cstdint>
+#include <cstdlib>
 #include <functional>
 #include <map>
 #include <opencv2/video/tracking.hpp>
@@ -24,10 +29,12 @@
 #include <vector>
 
 #include "flow/dense_lk.hpp"
+#include "flow/flo_io.hpp"
 #include "flow/metrics.hpp"
 #include "flow/pyramid.hpp"
 #include "flow/synthetic.hpp"
 #include "pipeline/tbb_executor.hpp"
+#include "stages/flow_eval.hpp"
 
 namespace {
 
@@ -121,14 +128,62 @@ void bm_pyramid(benchmark::State& state, cv::Size size) {
   const Scene& scene = scene_of(size);
   roiflow::pipeline::run_with_threads(1, [&] {
     for (auto _ : state) {
-      roiflow::flow::Pyramid pyr = roiflow::flow::build_pyramid(scene.frame0, 3, 1.0);
+      const roiflow::flow::LkParams paper = roiflow::flow::LkParams::paper();
+      roiflow::flow::Pyramid pyr =
+          roiflow::flow::build_pyramid(scene.frame0, paper.levels, paper.sigma);
       benchmark::DoNotOptimize(pyr.levels.data());
     }
     set_rate(state, size);
   });
 }
 
+// Real data with ground truth: the Middlebury pairs as scenes (frames, ground-truth flow).
+std::vector<Scene> middlebury_scenes(const std::string& dir) {
+  std::vector<Scene> scenes;
+  for (const roiflow::stages::EvalPair& pair : roiflow::stages::find_middlebury(dir)) {
+    scenes.push_back({roiflow::stages::read_gray(pair.frame0),
+                      roiflow::stages::read_gray(pair.frame1),
+                      roiflow::flow::read_flo(pair.ground_truth)});
+  }
+  return scenes;
+}
+
+void bm_middlebury(benchmark::State& state, const Method& method,
+                   const std::vector<Scene>* scenes) {
+  roiflow::pipeline::run_with_threads(1, [&] {
+    const FlowFn flow_fn = method.make();
+    std::vector<cv::Mat> flows(scenes->size());
+    for (auto _ : state) {
+      for (size_t i = 0; i < scenes->size(); ++i)
+        flow_fn((*scenes)[i], flows[i]);
+      benchmark::ClobberMemory();
+    }
+    double epe = 0, aae = 0;
+    for (size_t i = 0; i < scenes->size(); ++i) {
+      const roiflow::flow::FlowErrors e = roiflow::flow::flow_errors(flows[i], (*scenes)[i].flow);
+      epe += e.epe / static_cast<double>(scenes->size());
+      aae += e.aae_deg / static_cast<double>(scenes->size());
+    }
+    state.counters["EPE"] = epe;
+    state.counters["AAE"] = aae;
+    state.counters["ms_per_pair"] =
+        benchmark::Counter(static_cast<double>(state.iterations() * scenes->size()) / 1e3,
+                           benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  });
+}
+
 void register_benchmarks() {
+  if (const char* dir = std::getenv("ROIFLOW_MIDDLEBURY")) {
+    static const std::vector<Scene> scenes = middlebury_scenes(dir);
+    for (const Method& method : methods()) {
+      benchmark::RegisterBenchmark(
+          ("BM_Middlebury/" + std::string(method.name) + "/threads:1").c_str(), bm_middlebury,
+          method, &scenes)
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime()
+          ->Iterations(3);
+    }
+  }
   for (const cv::Size size : kSizes) {
     for (const Method& method : methods()) {
       for (const int threads : kThreadCounts) {

@@ -94,20 +94,13 @@ void warp_row(const cv::Mat& i1, const float* __restrict i0, int x0, int y, int 
     const __m256 vyhi = _mm256_set1_ps(yhi), vy = _mm256_set1_ps(fy0), half = _mm256_set1_ps(0.5f);
     const __m256i vixmax = _mm256_set1_epi32(ixmax), viymax = _mm256_set1_epi32(iymax);
     const __m256i vstep = _mm256_set1_epi32(step);
-    const __m128i step4 = _mm_set1_epi32(step);
-    const auto* pairs = reinterpret_cast<const double*>(base);
-    // The masked form with an explicit source: the plain intrinsic leaves its source
-    // undefined, which GCC reports as maybe-uninitialised.
-    const __m256d all = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
-    auto gather = [&](__m128i index) {
-      return _mm256_mask_i32gather_pd(_mm256_setzero_pd(), pairs, index, all, 4);
-    };
-    auto split = [](__m256d lo, __m256d hi, __m256& first, __m256& second) {
-      const __m256 a = _mm256_castpd_ps(lo), b = _mm256_castpd_ps(hi);
-      first = _mm256_castpd_ps(
-          _mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(a, b, 0x88)), 0xD8));
-      second = _mm256_castpd_ps(
-          _mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(a, b, 0xDD)), 0xD8));
+    // Each pixel's 2x2 neighbourhood is two 8-byte loads (rows iy and iy + 1 at ix): plain
+    // loads and a transpose, because gathers are slow on many x86 cores.
+    alignas(32) int index[8];
+    auto quad = [&](int i) {
+      const float* p = base + index[i];
+      const __m128 top = _mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(p)));
+      return _mm_loadh_pi(top, reinterpret_cast<const __m64*>(p + step));
     };
     for (; x + 8 <= w; x += 8) {
       const __m256 xs = _mm256_add_ps(_mm256_set1_ps(static_cast<float>(x0 + x)), lane);
@@ -120,10 +113,14 @@ void warp_row(const cv::Mat& i1, const float* __restrict i0, int x0, int y, int 
       const __m256 fx = _mm256_sub_ps(sx, _mm256_cvtepi32_ps(ix));
       const __m256 fy = _mm256_sub_ps(sy, _mm256_cvtepi32_ps(iy));
       const __m256i idx = _mm256_add_epi32(_mm256_mullo_epi32(iy, vstep), ix);
-      const __m128i idx_lo = _mm256_castsi256_si128(idx), idx_hi = _mm256_extracti128_si256(idx, 1);
-      __m256 p00, p01, p10, p11;
-      split(gather(idx_lo), gather(idx_hi), p00, p01);
-      split(gather(_mm_add_epi32(idx_lo, step4)), gather(_mm_add_epi32(idx_hi, step4)), p10, p11);
+      _mm256_store_si256(reinterpret_cast<__m256i*>(index), idx);
+      // q_i = (p00, p01, p10, p11) of pixel i; transposed so that each register holds one tap.
+      __m128 q0 = quad(0), q1 = quad(1), q2 = quad(2), q3 = quad(3);
+      __m128 q4 = quad(4), q5 = quad(5), q6 = quad(6), q7 = quad(7);
+      _MM_TRANSPOSE4_PS(q0, q1, q2, q3);
+      _MM_TRANSPOSE4_PS(q4, q5, q6, q7);
+      const __m256 p00 = _mm256_set_m128(q4, q0), p01 = _mm256_set_m128(q5, q1);
+      const __m256 p10 = _mm256_set_m128(q6, q2), p11 = _mm256_set_m128(q7, q3);
       const __m256 top = _mm256_fmadd_ps(fx, _mm256_sub_ps(p01, p00), p00);
       const __m256 bot = _mm256_fmadd_ps(fx, _mm256_sub_ps(p11, p10), p10);
       const __m256 w1 = _mm256_fmadd_ps(fy, _mm256_sub_ps(bot, top), top);
