@@ -58,7 +58,9 @@ constexpr int kChannels = 5;  // gxx, gxy, gyy, bx, by
 
 struct WarpedRow {
   int row = -1;
-  std::vector<float> m, d, u, v;  // padded by one on each side (replicated)
+  std::vector<float> m, d;   // padded by one on each side (replicated)
+  const float* u = nullptr;  // the row's current flow, not padded
+  const float* v = nullptr;
 };
 
 // Row buffers of one RowIterator. They live per thread and keep their capacity, so the
@@ -99,7 +101,7 @@ void warp_row(const cv::Mat& i1, const float* __restrict i0, int x0, int y, int 
     alignas(32) int index[8];
     auto quad = [&](int i) {
       const float* p = base + index[i];
-      const __m128 top = _mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(p)));
+      const __m128 top = _mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)));
       return _mm_loadh_pi(top, reinterpret_cast<const __m64*>(p + step));
     };
     for (; x + 8 <= w; x += 8) {
@@ -188,16 +190,20 @@ void hs_window_terms(int w, const float* __restrict m0, const float* __restrict 
                      const float* __restrict u0, const float* __restrict u1,
                      const float* __restrict v0, const float* __restrict v1, float inv_s2,
                      float* __restrict ring, float* __restrict acc) {
-  // The five channel rows of `ring` and `acc` are disjoint (w apart): no dependence.
-#pragma GCC ivdep
-  for (int x = 0; x < w; ++x) {
+  // The flow rows are not padded: the last column (x + 1 replicated) goes apart.
+  auto column = [&](int x, int x1) {
     const float ix = 0.5f * ((m0[x + 1] - m0[x]) + (m1[x + 1] - m1[x]));
     const float iy = 0.5f * ((m1[x] - m0[x]) + (m1[x + 1] - m0[x + 1]));
     const float it = 0.25f * (d0[x] + d0[x + 1] + d1[x] + d1[x + 1]);
-    const float ub = 0.25f * (u0[x] + u0[x + 1] + u1[x] + u1[x + 1]);
-    const float vb = 0.25f * (v0[x] + v0[x + 1] + v1[x] + v1[x + 1]);
+    const float ub = 0.25f * (u0[x] + u0[x1] + u1[x] + u1[x1]);
+    const float vb = 0.25f * (v0[x] + v0[x1] + v1[x] + v1[x1]);
     enter_all<kLeaving>(window_terms<kRobust>(ix, iy, it, ub, vb, inv_s2), w, x, ring, acc);
-  }
+  };
+  // The five channel rows of `ring` and `acc` are disjoint (w apart): no dependence.
+#pragma GCC ivdep
+  for (int x = 0; x < w - 1; ++x)
+    column(x, x + 1);
+  column(w - 1, w - 1);
 }
 
 // 3x3 Scharr (kScharr) or central differences on the pixel grid, rows up / centre / down.
@@ -233,18 +239,17 @@ void row_window_terms(Derivative derivative, const WarpedRow& up, const WarpedRo
     case Derivative::HornSchunck:
       // The cube spans this row and the next: `centre` and `down`.
       hs_window_terms<kRobust, kLeaving>(w, at(centre.m), at(down.m), at(centre.d), at(down.d),
-                                         at(centre.u), at(down.u), at(centre.v), at(down.v), inv_s2,
-                                         ring, acc);
+                                         centre.u, down.u, centre.v, down.v, inv_s2, ring, acc);
       break;
     case Derivative::Scharr:
       grid_window_terms<true, kRobust, kLeaving>(w, at(up.m), at(centre.m), at(down.m),
-                                                 at(centre.d), at(centre.u), at(centre.v), inv_s2,
-                                                 ring, acc);
+                                                 at(centre.d), centre.u, centre.v, inv_s2, ring,
+                                                 acc);
       break;
     case Derivative::Central:
       grid_window_terms<false, kRobust, kLeaving>(w, at(up.m), at(centre.m), at(down.m),
-                                                  at(centre.d), at(centre.u), at(centre.v), inv_s2,
-                                                  ring, acc);
+                                                  at(centre.d), centre.u, centre.v, inv_s2, ring,
+                                                  acc);
       break;
   }
 }
@@ -379,8 +384,6 @@ class RowIterator {
       e.row = -1;
       e.m.resize(padded_);
       e.d.resize(padded_);
-      e.u.resize(padded_);
-      e.v.resize(padded_);
     }
     // Rows of these buffers are always written before they are read: no clearing needed.
     ring_.resize(static_cast<size_t>(ring_rows_) * kChannels * w_);
@@ -448,11 +451,9 @@ class RowIterator {
     warp_row(*p_.i1, p_.i0->ptr<float>(gy) + p_.comp.x, p_.comp.x, gy, w_,
              u_old_ + static_cast<size_t>(r) * w_, v_old_ + static_cast<size_t>(r) * w_,
              e.m.data() + 1, e.d.data() + 1);
-    const float* u = u_old_ + static_cast<size_t>(r) * w_;
-    const float* v = v_old_ + static_cast<size_t>(r) * w_;
-    std::copy(u, u + w_, e.u.data() + 1);
-    std::copy(v, v + w_, e.v.data() + 1);
-    for (auto* vec : {&e.m, &e.d, &e.u, &e.v}) {
+    e.u = u_old_ + static_cast<size_t>(r) * w_;
+    e.v = v_old_ + static_cast<size_t>(r) * w_;
+    for (auto* vec : {&e.m, &e.d}) {
       (*vec)[0] = (*vec)[1];
       (*vec)[w_ + 1] = (*vec)[w_];
     }
@@ -749,7 +750,7 @@ FlowResult dense_flow(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkParam
   const Window win = make_window(params.patch, half_grid);
   // Flow at a pixel after one iteration depends on the previous flow within the window plus
   // the derivative stencil: computing on a margin of this many pixels per iteration makes a
-  // region's flow equal the whole frame's flow inside the region.
+  // region's flow equal the whole frame's flow inside the region (up to rounding).
   const int reach = win.reach() + 2;
   const int margin =
       params.iterations * reach + std::max(params.level_median, params.final_median) / 2;
