@@ -816,7 +816,8 @@ FlowResult dense_flow(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkParam
   const cv::Rect crop(region.tl() - comp[0].tl(), region.size());
   FlowResult result;
   cv::merge(std::vector<cv::Mat>{ws.u[0](crop), ws.v[0](crop)}, result.flow);
-  result.confidence = confidence(crop).clone();
+  // The level-0 buffer is this call's own; only a region needs a compact copy.
+  result.confidence = crop.size() == confidence.size() ? confidence : confidence(crop).clone();
   result.region = region;
   return result;
 }
