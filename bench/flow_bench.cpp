@@ -23,6 +23,7 @@
 #include <cstdlib>
 #include <functional>
 #include <map>
+#include <memory>
 #include <opencv2/video/tracking.hpp>
 #include <string>
 #include <utility>
@@ -77,8 +78,13 @@ FlowFn roiflow_flow(const roiflow::flow::LkParams& params) {
   static const roiflow::pipeline::TbbExecutor executor;
   roiflow::flow::FlowOptions options;
   options.executor = &executor;
-  return [params, options](const Scene& s, cv::Mat& flow) {
-    flow = roiflow::flow::dense_flow(s.frame0, s.frame1, params, options).flow;
+  // Writes into the caller's flow buffer and reuses the confidence buffer, as DIS's calc()
+  // reuses its output: neither side pays for fresh pages on every call.
+  auto result = std::make_shared<roiflow::flow::FlowResult>();
+  return [params, options, result](const Scene& s, cv::Mat& flow) {
+    result->flow = flow;
+    roiflow::flow::dense_flow(s.frame0, s.frame1, params, *result, options);
+    flow = result->flow;
   };
 }
 

@@ -609,6 +609,7 @@ struct Workspace {
   bool busy = false;
   Pyramid pyr_t, pyr_t1;
   std::vector<cv::Mat> u, v, u_next, v_next;  // per level
+  cv::Mat confidence;                         // level 0, when only a region is returned
 };
 
 class WorkspaceLease {
@@ -716,8 +717,8 @@ Derivative derivative_from_string(std::string_view name) {
   throw Error("unknown derivative '" + std::string(name) + "' (expected hs, scharr or central)");
 }
 
-FlowResult dense_flow(const cv::Mat& frame_t, const cv::Mat& frame_t1, const LkParams& params,
-                      const FlowOptions& options) {
+void dense_flow(const cv::Mat& frame_t, const cv::Mat& frame_t1, const LkParams& params,
+                FlowResult& result, const FlowOptions& options) {
   params.validate();
   if (frame_t.empty() || frame_t1.empty()) throw Error("input frame is empty");
   if (frame_t.size() != frame_t1.size()) {
@@ -729,11 +730,11 @@ FlowResult dense_flow(const cv::Mat& frame_t, const cv::Mat& frame_t1, const LkP
   Workspace& ws = *lease;
   build_pyramid(frame_t, params.levels, params.sigma, ws.pyr_t);
   build_pyramid(frame_t1, params.levels, params.sigma, ws.pyr_t1);
-  return dense_flow(ws.pyr_t, ws.pyr_t1, params, options);
+  dense_flow(ws.pyr_t, ws.pyr_t1, params, result, options);
 }
 
-FlowResult dense_flow(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkParams& params,
-                      const FlowOptions& options) {
+void dense_flow(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkParams& params,
+                FlowResult& result, const FlowOptions& options) {
   params.validate();
   const cv::Size size = pyr_t.size();
   if (size.empty() || pyr_t1.size() != size) throw Error("pyramids are empty or differ in size");
@@ -772,7 +773,9 @@ FlowResult dense_flow(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkParam
   Workspace& ws = *lease;
   for (auto* mats : {&ws.u, &ws.v, &ws.u_next, &ws.v_next})
     mats->resize(levels);
-  cv::Mat confidence;
+  // Level 0 computes the confidence straight into the result when the region is all of it.
+  const cv::Rect crop(region.tl() - comp[0].tl(), region.size());
+  cv::Mat& confidence = crop.size() == comp[0].size() ? result.confidence : ws.confidence;
   for (int l = levels - 1; l >= 0; --l) {
     const cv::Rect& c = comp[l];
     cv::Mat& u = ws.u[l];
@@ -806,19 +809,31 @@ FlowResult dense_flow(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkParam
     p.cy.resize(c.height);
     for (int y = 0; y < c.height; ++y)
       p.cy[y] = window_weight(win, y, c.height);
-    if (l == 0) confidence = cv::Mat(c.size(), CV_32F);
+    if (l == 0) confidence.create(c.size(), CV_32F);
     iterate_level(p, u, v, ws.u_next[l], ws.v_next[l], l == 0 ? &confidence : nullptr,
                   params.iterations, exec);
     if (l > 0) median_filter(u, v, params.level_median);
   }
   median_filter(ws.u[0], ws.v[0], params.final_median);
 
-  const cv::Rect crop(region.tl() - comp[0].tl(), region.size());
-  FlowResult result;
-  cv::merge(std::vector<cv::Mat>{ws.u[0](crop), ws.v[0](crop)}, result.flow);
-  // The level-0 buffer is this call's own; only a region needs a compact copy.
-  result.confidence = crop.size() == confidence.size() ? confidence : confidence(crop).clone();
+  const cv::Mat planes[] = {ws.u[0](crop), ws.v[0](crop)};
+  result.flow.create(crop.size(), CV_32FC2);
+  cv::merge(planes, 2, result.flow);
+  if (&confidence != &result.confidence) confidence(crop).copyTo(result.confidence);
   result.region = region;
+}
+
+FlowResult dense_flow(const cv::Mat& frame_t, const cv::Mat& frame_t1, const LkParams& params,
+                      const FlowOptions& options) {
+  FlowResult result;
+  dense_flow(frame_t, frame_t1, params, result, options);
+  return result;
+}
+
+FlowResult dense_flow(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkParams& params,
+                      const FlowOptions& options) {
+  FlowResult result;
+  dense_flow(pyr_t, pyr_t1, params, result, options);
   return result;
 }
 

@@ -88,6 +88,13 @@ FlowResult dense_flow(const cv::Mat& frame_t, const cv::Mat& frame_t1, const LkP
 FlowResult dense_flow(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkParams& params,
                       const FlowOptions& options = {});
 
+// The same into `result`, reusing its buffers when sizes match (as OpenCV's output arrays do):
+// a video loop then allocates nothing per frame. clone() what must outlive the next call.
+void dense_flow(const cv::Mat& frame_t, const cv::Mat& frame_t1, const LkParams& params,
+                FlowResult& result, const FlowOptions& options = {});
+void dense_flow(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkParams& params,
+                FlowResult& result, const FlowOptions& options = {});
+
 const char* to_string(Derivative d);
 Derivative derivative_from_string(std::string_view name);  // "hs", "scharr", "central"
 
