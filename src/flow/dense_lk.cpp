@@ -70,9 +70,13 @@ struct RowScratch {
   std::vector<float> ring, colsum, col, prefix;
 };
 
-RowScratch& thread_scratch() {
-  thread_local RowScratch scratch;
-  return scratch;
+// Scratch number `slot` of this thread: the iterations of a level that advance together as a
+// wavefront each need their own.
+RowScratch& thread_scratch(int slot) {
+  thread_local std::vector<std::unique_ptr<RowScratch>> scratch;
+  while (static_cast<int>(scratch.size()) <= slot)
+    scratch.push_back(std::make_unique<RowScratch>());
+  return *scratch[slot];
 }
 
 // Frame t+1 sampled bilinearly at x + flow(x) along one row (border replicated), returned
@@ -371,14 +375,15 @@ constexpr int kStripeRows = 32;
 // running sums -> 2x2 solve, so the working set stays a few rows wide.
 class RowIterator {
  public:
-  RowIterator(const LevelProblem& p, const float* u_old, const float* v_old)
+  RowIterator(const LevelProblem& p, const float* u_old, const float* v_old, int scratch_slot)
       : p_(p),
         u_old_(u_old),
         v_old_(v_old),
         w_(p.comp.width),
         h_(p.comp.height),
         ring_rows_(p.win.hi - p.win.lo + 1),
-        padded_(w_ + 2) {
+        padded_(w_ + 2),
+        scratch_(thread_scratch(scratch_slot)) {
     for (int i = 0; i < 4; ++i) {
       WarpedRow& e = warp_cache_[i];
       e.row = -1;
@@ -401,11 +406,25 @@ class RowIterator {
 
   // Rows [yb, ye) of the new flow. yb must be a multiple of kStripeRows (or 0).
   void run(int yb, int ye, float* u_new, float* v_new, float* confidence) {
-    const Window& win = p_.win;
-    for (int s = yb + win.lo; s < yb + win.hi; ++s)
+    start(yb);
+    for (int y = yb; y < ye; ++y)
+      next_row(u_new, v_new, confidence);
+  }
+
+  // Row by row: start(yb), then each next_row() writes the next row of the new flow. Row y
+  // reads rows y .. y + lookahead() of the previous flow.
+  void start(int yb) {
+    for (int s = yb + p_.win.lo; s < yb + p_.win.hi; ++s)
       advance(s, false);
-    for (int y = yb; y < ye; ++y) {
-      advance(y + win.hi, y > yb);
+    first_ = next_ = yb;
+  }
+  int lookahead() const { return p_.win.hi + 1; }
+
+  void next_row(float* u_new, float* v_new, float* confidence) {
+    const Window& win = p_.win;
+    const int y = next_++;
+    {
+      advance(y + win.hi, y > first_);
       // A running sum's rounding depends on where it started. Summing the window afresh at
       // every stripe boundary makes the result independent of how rows are split among
       // threads: bit-identical for any thread count.
@@ -531,7 +550,8 @@ class RowIterator {
   int w_, h_;
   int ring_rows_;
   int padded_;
-  RowScratch& scratch_ = thread_scratch();
+  RowScratch& scratch_;
+  int first_ = 0, next_ = 0;
   WarpedRow* warp_cache_ = scratch_.warp_cache;
   std::vector<float>& ring_ = scratch_.ring;
   std::vector<float>& colsum_ = scratch_.colsum;
@@ -547,18 +567,51 @@ void iterate_level(const LevelProblem& p, cv::Mat& u, cv::Mat& v, cv::Mat& u_nex
                    cv::Mat* confidence, int iterations, const Executor& executor) {
   u_next.create(u.size(), CV_32F);
   v_next.create(v.size(), CV_32F);
-  for (int it = 0; it < iterations; ++it) {
-    const bool last = it + 1 == iterations;
-    float* conf = (last && confidence) ? confidence->ptr<float>() : nullptr;
-    const float* uo = u.ptr<float>();
-    const float* vo = v.ptr<float>();
-    float* un = u_next.ptr<float>();
-    float* vn = v_next.ptr<float>();
-    const int stripes = (p.comp.height + kStripeRows - 1) / kStripeRows;
-    executor.for_range(0, stripes, 1, [&](int sb, int se) {
-      RowIterator rows(p, uo, vo);
-      rows.run(sb * kStripeRows, std::min(p.comp.height, se * kStripeRows), un, vn, conf);
-    });
+  const int h = p.comp.height;
+  // Iteration k reads the flow of iteration k - 1 (ping-pong between the two buffers) and
+  // writes its own; the last one also the confidence.
+  auto input = [&](int k, int plane) -> cv::Mat& {
+    return (k % 2 == 0) ? (plane == 0 ? u : v) : (plane == 0 ? u_next : v_next);
+  };
+  auto output = [&](int k, int plane) -> cv::Mat& { return input(k + 1, plane); };
+  auto conf_of = [&](int k) {
+    return (k + 1 == iterations && confidence) ? confidence->ptr<float>() : nullptr;
+  };
+  if (executor.concurrency() == 1) {
+    // One thread: all iterations advance together as a wavefront, iteration k a fixed lag
+    // behind k - 1, so each row is read again while it is still in cache instead of once per
+    // pass over the level. Iteration k + 1 overwrites a row of k - 1's buffer only after
+    // iteration k, the last reader of that row, has moved past it.
+    std::vector<RowIterator> rows;
+    rows.reserve(iterations);
+    for (int k = 0; k < iterations; ++k) {
+      rows.emplace_back(p, input(k, 0).ptr<float>(), input(k, 1).ptr<float>(), k);
+    }
+    const int lag = rows[0].lookahead() + 1;
+    for (int t = 0; t < h + (iterations - 1) * lag; ++t) {
+      for (int k = 0; k < iterations; ++k) {
+        const int y = t - k * lag;
+        if (y == 0) rows[k].start(0);  // reads rows 0 .. lookahead() - 1 of its input
+        if (y >= 0 && y < h) {
+          rows[k].next_row(output(k, 0).ptr<float>(), output(k, 1).ptr<float>(), conf_of(k));
+        }
+      }
+    }
+  } else {
+    for (int k = 0; k < iterations; ++k) {
+      const float* uo = input(k, 0).ptr<float>();
+      const float* vo = input(k, 1).ptr<float>();
+      float* un = output(k, 0).ptr<float>();
+      float* vn = output(k, 1).ptr<float>();
+      float* conf = conf_of(k);
+      const int stripes = (h + kStripeRows - 1) / kStripeRows;
+      executor.for_range(0, stripes, 1, [&](int sb, int se) {
+        RowIterator stripe(p, uo, vo, 0);
+        stripe.run(sb * kStripeRows, std::min(h, se * kStripeRows), un, vn, conf);
+      });
+    }
+  }
+  if (iterations % 2 == 1) {
     std::swap(u, u_next);
     std::swap(v, v_next);
   }

@@ -19,6 +19,8 @@ class Executor {
   // the range allows it. Returns when all calls have returned.
   virtual void for_range(int begin, int end, int grain,
                          const std::function<void(int, int)>& body) const = 0;
+  // How many bodies may run at once; 1 lets the caller pick a serial schedule instead.
+  virtual int concurrency() const = 0;
 };
 
 class SerialExecutor final : public Executor {
@@ -27,6 +29,7 @@ class SerialExecutor final : public Executor {
                  const std::function<void(int, int)>& body) const override {
     if (begin < end) body(begin, end);
   }
+  int concurrency() const override { return 1; }
 };
 
 }  // namespace roiflow::flow

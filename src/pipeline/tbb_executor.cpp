@@ -46,6 +46,10 @@ void TbbExecutor::for_range(int begin, int end, int grain,
       tbb::auto_partitioner());
 }
 
+int TbbExecutor::concurrency() const {
+  return tbb::this_task_arena::max_concurrency();
+}
+
 ThreadScope::ThreadScope(int threads)
     : previous_cv_threads_(cv::getNumThreads()), arena_(validated_thread_count(threads)) {
   cv::setNumThreads(threads);

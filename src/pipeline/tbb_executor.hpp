@@ -32,6 +32,8 @@ class TbbExecutor final : public flow::Executor {
   // counts as 1. An exception thrown by body cancels the remaining sub-ranges and is rethrown.
   void for_range(int begin, int end, int grain,
                  const std::function<void(int, int)>& body) const override;
+  // The caller's arena's thread count.
+  int concurrency() const override;
 };
 
 // Holds OpenCV at `threads` threads and owns an arena of `threads` slots while it lives.
