@@ -1,8 +1,8 @@
 // End-to-end tests of the roiflow binary: exit codes, stdout, the one-line error contract and
 // the files it leaves behind.
 #include <gtest/gtest.h>
-#include <stdlib.h>
 #include <sys/wait.h>
+#include <cstdlib>
 
 #include <filesystem>
 #include <fstream>
@@ -15,6 +15,7 @@
 
 #include "flow/flo_io.hpp"
 #include "flow/synthetic.hpp"
+#include "test_util.hpp"
 
 namespace {
 
@@ -57,17 +58,8 @@ void append_quoted(std::string& command, const std::string& arg) {
   command += '\'';
 }
 
-class CliTest : public ::testing::Test {
+class CliTest : public test::TempDirTest {
  protected:
-  void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "roiflow_cli_XXXXXX").string();
-    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  std::string path(const std::string& relative) const { return (dir_ / relative).string(); }
-
   CliResult run(const std::vector<std::string>& args) const {
     std::string command;
     append_quoted(command, ROIFLOW_CLI_PATH);
@@ -97,8 +89,6 @@ class CliTest : public ::testing::Test {
     write_image(tree + "/" + name + "/frame11.png", scene.frame1);
     flow::write_flo(path(tree + "/" + name + "/flow10.flo"), scene.flow);
   }
-
-  fs::path dir_;
 };
 
 // Every failure: non-zero exit, one line on stderr in the CLI's format, nothing on stdout.

@@ -13,6 +13,7 @@
 #include "flow/metrics.hpp"
 #include "flow/synthetic.hpp"
 #include "pipeline/tbb_executor.hpp"
+#include "test_util.hpp"
 
 // Every accuracy bar below is the value measured on the implementation of this commit (Release,
 // x86-64 with AVX2; "measured" comments) plus about 20 %: a real regression of 30 % fails, the
@@ -81,17 +82,7 @@ LkParams with_derivative(LkParams p, Derivative d) {
   return p;
 }
 
-template <class F>
-std::string error_message(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    return std::string("unexpected exception type: ") + e.what();
-  }
-  return "no exception";
-}
+using test::error_message;
 
 // Parameter sets for the properties that must hold for every setting: both presets (the
 // accurate one adds robust weights and medians), an even and an odd patch, both derivative

@@ -1,7 +1,6 @@
 #include "stages/flow_eval.hpp"
 
 #include <gtest/gtest.h>
-#include <stdlib.h>
 
 #include <filesystem>
 #include <fstream>
@@ -15,6 +14,7 @@
 #include "flow/error.hpp"
 #include "flow/flo_io.hpp"
 #include "flow/synthetic.hpp"
+#include "test_util.hpp"
 
 namespace roiflow::stages {
 namespace {
@@ -52,17 +52,8 @@ EvalRow row(const std::string& name, double aae, double epe, double r1, double r
   return r;
 }
 
-class FlowEvalTest : public ::testing::Test {
+class FlowEvalTest : public test::TempDirTest {
  protected:
-  void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "roiflow_flow_eval_XXXXXX").string();
-    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  std::string path(const std::string& relative) const { return (dir_ / relative).string(); }
-
   void write_image(const std::string& relative, const cv::Mat& image) const {
     fs::create_directories(fs::path(path(relative)).parent_path());
     ASSERT_TRUE(cv::imwrite(path(relative), image));
@@ -84,8 +75,6 @@ class FlowEvalTest : public ::testing::Test {
     flow::write_flo(path("gt.flo"), scene.flow);
     return {"translation", path("a.png"), path("b.png"), path("gt.flo"), ""};
   }
-
-  fs::path dir_;
 };
 
 TEST_F(FlowEvalTest, FindsCompleteSequencesSortedPreferringGray) {

@@ -10,21 +10,12 @@
 #include "flow/dense_lk.hpp"
 #include "flow/error.hpp"
 #include "flow/synthetic.hpp"
+#include "test_util.hpp"
 
 namespace roiflow::flow {
 namespace {
 
-template <class F>
-std::string error_message(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    return std::string("unexpected exception type: ") + e.what();
-  }
-  return "no exception";
-}
+using test::error_message;
 
 cv::Mat random_image(cv::Size size, int type, std::uint64_t seed) {
   cv::Mat m(size, type);
