@@ -3,6 +3,7 @@
 //   roiflow flow --synthetic -o out.flo --color out.png
 //   roiflow flow A.png B.png -o out.flo --gt truth.flo
 //   roiflow eval data/middlebury --format csv -o errors.csv
+//   roiflow score track.csv Car4/groundtruth_rect.txt --format json
 //
 // Each subcommand is a thin layer: CLI11 parses, the library computes, this file prints.
 // Failures print one line, `roiflow: error: <message>`, on stderr: exit code 2 for a bad
@@ -15,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <optional>
 #include <string>
@@ -29,6 +31,8 @@
 #include "flow/synthetic.hpp"
 #include "pipeline/tbb_executor.hpp"
 #include "stages/flow_eval.hpp"
+#include "stages/otb_score.hpp"
+#include "stages/track_log.hpp"
 
 namespace {
 
@@ -396,6 +400,60 @@ void add_eval_command(CLI::App& app, EvalCommand& cmd) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// roiflow score
+
+struct ScoreCommand {
+  std::string track;
+  std::string ground_truth;
+  std::string format = "table";
+};
+
+void run_score(const ScoreCommand& cmd) {
+  const std::vector<stages::TrackRecord> records = stages::read_track_csv(cmd.track);
+  std::vector<cv::Rect2f> track;
+  try {
+    track = stages::track_boxes(records);
+  } catch (const Error& e) {
+    // track_boxes knows records, not the file they came from.
+    throw Error("track log '" + cmd.track + "': " + e.what());
+  }
+  const std::vector<cv::Rect2f> truth = stages::read_ground_truth(cmd.ground_truth);
+  const stages::OtbScore s = stages::score(track, truth);
+
+  if (cmd.format == "json") {
+    const nlohmann::ordered_json doc = {{"auc", s.auc},
+                                        {"precision20", s.precision20},
+                                        {"mean_iou", s.mean_iou},
+                                        {"frames", s.frames}};
+    std::cout << doc.dump(2) << "\n";
+    return;
+  }
+  // The lengths are shown because a shorter track (--max-frames) scores only its prefix.
+  std::cout << "success AUC    " << fixed(s.auc, 4) << "\n"
+            << "precision@20   " << fixed(s.precision20, 4) << "\n"
+            << "mean IoU       " << fixed(s.mean_iou, 4) << "\n"
+            << "frames         " << s.frames << " (track " << track.size() << ", ground truth "
+            << truth.size() << ")\n";
+}
+
+void add_score_command(CLI::App& app, ScoreCommand& cmd) {
+  CLI::App* sub =
+      app.add_subcommand("score", "OTB one-pass metrics of a track log against ground-truth boxes");
+  sub->add_option("TRACK", cmd.track, "track log written by roiflow track (CSV)")
+      ->type_name("CSV")
+      ->required();
+  sub->add_option("GROUNDTRUTH", cmd.ground_truth,
+                  "one box x,y,w,h per frame, separated by commas, tabs or spaces")
+      ->type_name("TXT")
+      ->required();
+  sub->add_option("--format", cmd.format, "output format")
+      ->type_name("FORMAT")
+      ->check(CLI::IsMember({"table", "json"}))
+      ->capture_default_str();
+  sub->callback([&cmd] { run_score(cmd); });
+}
+
+// ---------------------------------------------------------------------------------------------
 
 // OpenCV's messages span lines; the CLI promises one.
 std::string one_line(std::string text) {
@@ -427,8 +485,10 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   FlowCommand flow_cmd;
   EvalCommand eval_cmd;
+  ScoreCommand score_cmd;
   add_flow_command(app, flow_cmd);
   add_eval_command(app, eval_cmd);
+  add_score_command(app, score_cmd);
 
   try {
     app.parse(argc, argv);

@@ -265,4 +265,85 @@ TEST_F(CliTest, BadInputsFailWithOneLineAndNoOutput) {
   }
 }
 
+// --- roiflow score ------------------------------------------------------------------------------
+
+// Five 40x40 ground-truth boxes, written with the separators OTB files mix, and a track log 10 px
+// to the right of them: IoU 0.6 everywhere, centre error 10 px.
+class CliScoreTest : public CliTest {
+ protected:
+  void SetUp() override {
+    CliTest::SetUp();
+    std::ofstream truth(path("gt.txt"), std::ios::binary);
+    std::ofstream track(path("track.csv"), std::ios::binary);
+    track << "frame,x,y,w,h,vx,vy,mode,lost,ms\n";
+    const char* separators[] = {",", "\t", " ", ", ", ","};
+    for (int i = 0; i < 5; ++i) {
+      const int x = 100 + 4 * i;
+      const std::string sep = separators[i];
+      truth << x << sep << 50 << sep << 40 << sep << 40 << "\r\n";
+      track << i + 1 << "," << x + 10 << ".00,50.00,40.00,40.00,4.000,0.000,"
+            << (i == 0 ? "global" : "local") << ",0,0.250\n";
+    }
+  }
+};
+
+TEST_F(CliScoreTest, JsonHasExactlyTheFourMetrics) {
+  const CliResult r = run({"score", path("track.csv"), path("gt.txt"), "--format", "json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  const nlohmann::json doc = nlohmann::json::parse(r.out);
+  ASSERT_TRUE(doc.is_object());
+  std::vector<std::string> keys;
+  for (const auto& item : doc.items())
+    keys.push_back(item.key());
+  EXPECT_EQ(keys, (std::vector<std::string>{"auc", "frames", "mean_iou", "precision20"}));
+  EXPECT_NEAR(doc["auc"].get<double>(), 12.0 / 21.0, 1e-12);
+  EXPECT_NEAR(doc["precision20"].get<double>(), 1.0, 1e-12);
+  EXPECT_NEAR(doc["mean_iou"].get<double>(), 0.6, 1e-12);
+  EXPECT_TRUE(doc["frames"].is_number_integer());
+  EXPECT_EQ(doc["frames"], 5);
+}
+
+TEST_F(CliScoreTest, TableShowsTheMetricsAndLengths) {
+  const CliResult r = run({"score", path("track.csv"), path("gt.txt")});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(lines_of(r.out).size(), 4u) << r.out;
+  EXPECT_NE(r.out.find("success AUC    0.5714"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("precision@20   1.0000"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("mean IoU       0.6000"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("frames         5 (track 5, ground truth 5)"), std::string::npos) << r.out;
+}
+
+TEST_F(CliScoreTest, BadInputsFailWithOneLine) {
+  std::ofstream(path("bad_header.csv"), std::ios::binary) << "frame,x,y,w,h\n1,1,2,3,4\n";
+  std::ofstream(path("gap.csv"), std::ios::binary)
+      << "frame,x,y,w,h,vx,vy,mode,lost,ms\n1,1,2,3,4,0,0,local,0,1\n3,1,2,3,4,0,0,local,0,1\n";
+  std::ofstream(path("bad_gt.txt"), std::ios::binary) << "1,2,3,4\n1,2,three,4\n";
+  std::ofstream(path("absent_gt.txt"), std::ios::binary) << "0,0,0,0\nNaN,NaN,NaN,NaN\n";
+  struct Case {
+    std::vector<std::string> args;
+    int exit_code;
+    std::string expected;  // in the error line
+  };
+  const std::vector<Case> cases = {
+      {{"score", path("missing.csv"), path("gt.txt")}, 1, path("missing.csv")},
+      {{"score", path("track.csv"), path("missing.txt")}, 1, path("missing.txt")},
+      {{"score", path("bad_header.csv"), path("gt.txt")}, 1, path("bad_header.csv") + ":1:"},
+      {{"score", path("gap.csv"), path("gt.txt")}, 1, "record 2 is frame 3"},
+      {{"score", path("track.csv"), path("bad_gt.txt")}, 1, path("bad_gt.txt") + ":2:"},
+      {{"score", path("track.csv"), path("absent_gt.txt")}, 1, "no frame to score"},
+      {{"score", path("track.csv")}, 2, "GROUNDTRUTH"},
+      {{"score", path("track.csv"), path("gt.txt"), "--format", "csv"}, 2, "--format"},
+  };
+  for (const Case& c : cases) {
+    std::string shown;
+    for (const std::string& arg : c.args)
+      shown += " " + arg;
+    SCOPED_TRACE("roiflow" + shown);
+    const CliResult r = run(c.args);
+    expect_one_line_error(r, c.exit_code);
+    EXPECT_NE(r.err.find(c.expected), std::string::npos) << r.err;
+  }
+}
+
 }  // namespace

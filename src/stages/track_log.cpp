@@ -1,0 +1,247 @@
+#include "stages/track_log.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string_view>
+#include <system_error>
+
+#include "flow/error.hpp"
+
+namespace roiflow::stages {
+namespace {
+
+constexpr std::string_view kCsvHeader = "frame,x,y,w,h,vx,vy,mode,lost,ms";
+constexpr int kBoxDecimals = 2;
+constexpr int kVelocityDecimals = 3;
+constexpr int kMsDecimals = 3;
+
+// "-0.00" would read back as a distinct value in some tools and looks like a sign error.
+std::string fixed(double value, int decimals) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
+  std::string text = buffer;
+  if (text.front() == '-' && text.find_first_not_of("-0.") == std::string::npos) text.erase(0, 1);
+  return text;
+}
+
+// The JSON log carries exactly the values of the CSV log, so both score identically.
+double rounded(double value, int decimals) {
+  return std::stod(fixed(value, decimals));
+}
+
+const char* mode_name(TrackRecord::Mode mode) {
+  return mode == TrackRecord::Mode::Local ? "local" : "global";
+}
+
+std::string lowercase_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+void check_record(const TrackRecord& r, const std::string& path) {
+  const std::string where = "track log '" + path + "', frame " + std::to_string(r.frame) + ": ";
+  if (r.frame < 1) throw Error(where + "frames are numbered from 1");
+  const double values[] = {r.box.x,      r.box.y,      r.box.width, r.box.height,
+                           r.velocity.x, r.velocity.y, r.ms};
+  const char* names[] = {"x", "y", "w", "h", "vx", "vy", "ms"};
+  for (int i = 0; i < 7; ++i) {
+    if (!std::isfinite(values[i])) {
+      throw Error(where + names[i] + " is " + std::to_string(values[i]) + ", not a finite number");
+    }
+  }
+  if (r.box.width < 0 || r.box.height < 0) {
+    throw Error(where + "negative box size " + std::to_string(r.box.width) + "x" +
+                std::to_string(r.box.height));
+  }
+}
+
+std::string csv_line(const TrackRecord& r) {
+  return std::to_string(r.frame) + "," + fixed(r.box.x, kBoxDecimals) + "," +
+         fixed(r.box.y, kBoxDecimals) + "," + fixed(r.box.width, kBoxDecimals) + "," +
+         fixed(r.box.height, kBoxDecimals) + "," + fixed(r.velocity.x, kVelocityDecimals) + "," +
+         fixed(r.velocity.y, kVelocityDecimals) + "," + mode_name(r.mode) + "," +
+         (r.lost ? "1" : "0") + "," + fixed(r.ms, kMsDecimals) + "\n";
+}
+
+std::string json_object(const TrackRecord& r) {
+  const nlohmann::ordered_json object = {{"frame", r.frame},
+                                         {"x", rounded(r.box.x, kBoxDecimals)},
+                                         {"y", rounded(r.box.y, kBoxDecimals)},
+                                         {"w", rounded(r.box.width, kBoxDecimals)},
+                                         {"h", rounded(r.box.height, kBoxDecimals)},
+                                         {"vx", rounded(r.velocity.x, kVelocityDecimals)},
+                                         {"vy", rounded(r.velocity.y, kVelocityDecimals)},
+                                         {"mode", mode_name(r.mode)},
+                                         {"lost", r.lost},
+                                         {"ms", rounded(r.ms, kMsDecimals)}};
+  return object.dump();
+}
+
+// --- reading ---------------------------------------------------------------------------------
+
+// Shown in messages: a binary file read as text must not produce a screenful.
+std::string excerpt(std::string_view text) {
+  constexpr std::size_t kMax = 40;
+  std::string shown(1, '\'');
+  shown.append(text.substr(0, kMax));
+  shown.append(text.size() > kMax ? "...'" : "'");
+  return shown;
+}
+
+class LineError {
+ public:
+  LineError(const std::string& path, long long line) : prefix_(path + ":" + std::to_string(line)) {}
+  [[noreturn]] void fail(const std::string& what) const { throw Error(prefix_ + ": " + what); }
+
+ private:
+  std::string prefix_;
+};
+
+std::vector<std::string_view> split_commas(std::string_view line) {
+  std::vector<std::string_view> fields;
+  for (std::size_t start = 0;;) {
+    const std::size_t comma = line.find(',', start);
+    fields.push_back(line.substr(start, comma - start));
+    if (comma == std::string_view::npos) return fields;
+    start = comma + 1;
+  }
+}
+
+double parse_number(std::string_view field, const char* name, const LineError& error) {
+  double value = 0;
+  const auto [end, ec] = std::from_chars(field.data(), field.data() + field.size(), value);
+  if (ec != std::errc() || end != field.data() + field.size() || !std::isfinite(value)) {
+    error.fail(std::string(name) + " " + excerpt(field) + " is not a finite number");
+  }
+  return value;
+}
+
+TrackRecord parse_row(std::string_view line, const LineError& error) {
+  const std::vector<std::string_view> f = split_commas(line);
+  if (f.size() != 10) {
+    error.fail("expected 10 fields (" + std::string(kCsvHeader) + "), got " +
+               std::to_string(f.size()));
+  }
+  TrackRecord r;
+  const auto [end, ec] = std::from_chars(f[0].data(), f[0].data() + f[0].size(), r.frame);
+  if (ec != std::errc() || end != f[0].data() + f[0].size() || r.frame < 1) {
+    error.fail("frame " + excerpt(f[0]) + " is not a frame number (1, 2, ...)");
+  }
+  r.box.x = static_cast<float>(parse_number(f[1], "x", error));
+  r.box.y = static_cast<float>(parse_number(f[2], "y", error));
+  r.box.width = static_cast<float>(parse_number(f[3], "w", error));
+  r.box.height = static_cast<float>(parse_number(f[4], "h", error));
+  if (r.box.width < 0 || r.box.height < 0) {
+    error.fail("negative box size " + std::string(f[3]) + "x" + std::string(f[4]));
+  }
+  r.velocity.x = static_cast<float>(parse_number(f[5], "vx", error));
+  r.velocity.y = static_cast<float>(parse_number(f[6], "vy", error));
+  if (f[7] == "local") {
+    r.mode = TrackRecord::Mode::Local;
+  } else if (f[7] == "global") {
+    r.mode = TrackRecord::Mode::Global;
+  } else {
+    error.fail("mode " + excerpt(f[7]) + " is neither local nor global");
+  }
+  if (f[8] != "0" && f[8] != "1") error.fail("lost " + excerpt(f[8]) + " is neither 0 nor 1");
+  r.lost = f[8] == "1";
+  r.ms = parse_number(f[9], "ms", error);
+  return r;
+}
+
+}  // namespace
+
+TrackLogWriter::TrackLogWriter(const std::string& path) : path_(path) {
+  const std::string ext = lowercase_extension(path);
+  if (ext != ".csv" && ext != ".json") {
+    throw Error("track log '" + path + "': unknown format '" + ext + "' (name it .csv or .json)");
+  }
+  json_ = ext == ".json";
+  out_.open(path, std::ios::binary | std::ios::trunc);
+  if (!out_) throw Error("cannot create track log '" + path + "'");
+  if (json_) {
+    out_ << "[";
+    array_end_ = out_.tellp();
+    out_ << "\n]\n";
+  } else {
+    out_ << kCsvHeader << "\n";
+  }
+  out_.flush();
+  check_stream("write");
+}
+
+TrackLogWriter::~TrackLogWriter() {
+  // A destructor may run while an exception unwinds; the log is already flushed and valid.
+  try {
+    close();
+  } catch (const Error&) {
+  }
+}
+
+void TrackLogWriter::write(const TrackRecord& record) {
+  if (!out_.is_open()) {
+    throw Error("track log '" + path_ + "' is closed; frame " + std::to_string(record.frame) +
+                " not written");
+  }
+  check_record(record, path_);
+  if (json_) {
+    // One write per record, so a kill can tear at most the line being written.
+    out_.seekp(array_end_);
+    out_ << (records_ == 0 ? "\n" : ",\n") + json_object(record);
+    array_end_ = out_.tellp();
+    out_ << "\n]\n";
+  } else {
+    out_ << csv_line(record);
+  }
+  out_.flush();
+  check_stream("write");
+  ++records_;
+}
+
+void TrackLogWriter::close() {
+  if (!out_.is_open()) return;
+  out_.close();
+  check_stream("close");
+}
+
+void TrackLogWriter::check_stream(const char* action) {
+  if (out_.fail()) throw Error(std::string("cannot ") + action + " track log '" + path_ + "'");
+}
+
+std::vector<TrackRecord> read_track_csv(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    throw Error("cannot read track log '" + path + "': no such file");
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error("cannot open track log '" + path + "'");
+
+  std::vector<TrackRecord> records;
+  std::string line;
+  long long number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const LineError error(path, number);
+    if (number == 1) {
+      if (line != kCsvHeader) {
+        error.fail("header " + excerpt(line) + " is not '" + std::string(kCsvHeader) + "'");
+      }
+      continue;
+    }
+    records.push_back(parse_row(line, error));
+  }
+  if (in.bad()) throw Error("cannot read track log '" + path + "'");
+  if (number == 0)
+    LineError(path, 1).fail("empty file, expected '" + std::string(kCsvHeader) + "'");
+  return records;
+}
+
+}  // namespace roiflow::stages
