@@ -10,6 +10,7 @@
 #include <system_error>
 
 #include "flow/error.hpp"
+#include "stages/quote.hpp"
 
 namespace roiflow::stages {
 namespace {
@@ -29,15 +30,6 @@ bool has_area(const cv::Rect2f& r) {
 
 bool is_space(char c) {
   return c == ' ' || c == '\t';
-}
-
-// Shown in messages: a binary file read as text must not produce a screenful.
-std::string excerpt(std::string_view text) {
-  constexpr std::size_t kMax = 40;
-  std::string shown(1, '\'');
-  shown.append(text.substr(0, kMax));
-  shown.append(text.size() > kMax ? "...'" : "'");
-  return shown;
 }
 
 // Values are separated by a run of spaces and tabs, or by one comma with optional spaces
@@ -78,13 +70,13 @@ cv::Rect2f parse_box(std::string_view line, const std::string& where) {
     const std::string_view t = text[k];
     const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v[k]);
     if (ec != std::errc() || end != t.data() + t.size() || std::isinf(v[k])) {
-      throw Error(where + "value " + std::to_string(k + 1) + " " + excerpt(t) +
+      throw Error(where + "value " + std::to_string(k + 1) + " " + quoted_excerpt(t) +
                   " is not a finite number");
     }
     if (std::isnan(v[k])) ++nans;
   }
   if (nans != 0 && nans != 4) {
-    throw Error(where + "partly NaN box " + excerpt(line) + " (an absent target is 4 NaN)");
+    throw Error(where + "partly NaN box " + quoted_excerpt(line) + " (an absent target is 4 NaN)");
   }
   if (v[2] < 0 || v[3] < 0) {
     throw Error(where + "negative size " + std::string(text[2]) + "x" + std::string(text[3]));

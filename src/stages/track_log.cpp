@@ -11,6 +11,7 @@
 #include <system_error>
 
 #include "flow/error.hpp"
+#include "stages/quote.hpp"
 
 namespace roiflow::stages {
 namespace {
@@ -86,15 +87,6 @@ std::string json_object(const TrackRecord& r) {
 
 // --- reading ---------------------------------------------------------------------------------
 
-// Shown in messages: a binary file read as text must not produce a screenful.
-std::string excerpt(std::string_view text) {
-  constexpr std::size_t kMax = 40;
-  std::string shown(1, '\'');
-  shown.append(text.substr(0, kMax));
-  shown.append(text.size() > kMax ? "...'" : "'");
-  return shown;
-}
-
 class LineError {
  public:
   LineError(const std::string& path, long long line) : prefix_(path + ":" + std::to_string(line)) {}
@@ -118,7 +110,7 @@ double parse_number(std::string_view field, const char* name, const LineError& e
   double value = 0;
   const auto [end, ec] = std::from_chars(field.data(), field.data() + field.size(), value);
   if (ec != std::errc() || end != field.data() + field.size() || !std::isfinite(value)) {
-    error.fail(std::string(name) + " " + excerpt(field) + " is not a finite number");
+    error.fail(std::string(name) + " " + quoted_excerpt(field) + " is not a finite number");
   }
   return value;
 }
@@ -132,7 +124,7 @@ TrackRecord parse_row(std::string_view line, const LineError& error) {
   TrackRecord r;
   const auto [end, ec] = std::from_chars(f[0].data(), f[0].data() + f[0].size(), r.frame);
   if (ec != std::errc() || end != f[0].data() + f[0].size() || r.frame < 1) {
-    error.fail("frame " + excerpt(f[0]) + " is not a frame number (1, 2, ...)");
+    error.fail("frame " + quoted_excerpt(f[0]) + " is not a frame number (1, 2, ...)");
   }
   r.box.x = static_cast<float>(parse_number(f[1], "x", error));
   r.box.y = static_cast<float>(parse_number(f[2], "y", error));
@@ -148,9 +140,10 @@ TrackRecord parse_row(std::string_view line, const LineError& error) {
   } else if (f[7] == "global") {
     r.mode = TrackRecord::Mode::Global;
   } else {
-    error.fail("mode " + excerpt(f[7]) + " is neither local nor global");
+    error.fail("mode " + quoted_excerpt(f[7]) + " is neither local nor global");
   }
-  if (f[8] != "0" && f[8] != "1") error.fail("lost " + excerpt(f[8]) + " is neither 0 nor 1");
+  if (f[8] != "0" && f[8] != "1")
+    error.fail("lost " + quoted_excerpt(f[8]) + " is neither 0 nor 1");
   r.lost = f[8] == "1";
   r.ms = parse_number(f[9], "ms", error);
   return r;
@@ -232,7 +225,7 @@ std::vector<TrackRecord> read_track_csv(const std::string& path) {
     const LineError error(path, number);
     if (number == 1) {
       if (line != kCsvHeader) {
-        error.fail("header " + excerpt(line) + " is not '" + std::string(kCsvHeader) + "'");
+        error.fail("header " + quoted_excerpt(line) + " is not '" + std::string(kCsvHeader) + "'");
       }
       continue;
     }
