@@ -382,13 +382,12 @@ class RowIterator {
         w_(p.comp.width),
         h_(p.comp.height),
         ring_rows_(p.win.hi - p.win.lo + 1),
-        padded_(w_ + 2),
         scratch_(thread_scratch(scratch_slot)) {
     for (int i = 0; i < 4; ++i) {
       WarpedRow& e = warp_cache_[i];
       e.row = -1;
-      e.m.resize(padded_);
-      e.d.resize(padded_);
+      e.m.resize(w_ + 2);  // one replicated column on each side
+      e.d.resize(w_ + 2);
     }
     // Rows of these buffers are always written before they are read: no clearing needed.
     ring_.resize(static_cast<size_t>(ring_rows_) * kChannels * w_);
@@ -423,40 +422,38 @@ class RowIterator {
   void next_row(float* u_new, float* v_new, float* confidence) {
     const Window& win = p_.win;
     const int y = next_++;
-    {
-      advance(y + win.hi, y > first_);
-      // A running sum's rounding depends on where it started. Summing the window afresh at
-      // every stripe boundary makes the result independent of how rows are split among
-      // threads: bit-identical for any thread count.
-      if (y % kStripeRows == 0) resum_window(y);
-      const float* columns = colsum_.data();
-      int stride = w_;
-      if (win.half) {
-        half_weight_ends(y);
-        columns = col_.data() + hpad_lo_;
-        stride = col_stride_;
-      }
-      const size_t pstride = prefix_stride_;
-      float* prefix = prefix_.data() + prefix_pad_;
-      prefix_scan(columns, stride, w_, prefix, pstride);
-      for (int c = 0; c < kChannels; ++c) {
-        float* pc = prefix + c * pstride;
-        std::fill(pc + w_, pc + w_ + win.hi, pc[w_ - 1]);
-      }
-      const size_t off = static_cast<size_t>(y) * w_;
-      WindowSolve ws{w_,
-                     prefix,
-                     pstride,
-                     win.half ? columns : nullptr,
-                     stride,
-                     win.lo,
-                     win.hi,
-                     p_.inv_cx.data(),
-                     1.f / p_.cy[y],
-                     p_.lambda};
-      solve_pixels(ws, u_old_ + off, v_old_ + off, u_new + off, v_new + off,
-                   confidence ? confidence + off : nullptr);
+    advance(y + win.hi, y > first_);
+    // A running sum's rounding depends on where it started. Summing the window afresh at
+    // every stripe boundary makes the result independent of how rows are split among
+    // threads: bit-identical for any thread count.
+    if (y % kStripeRows == 0) resum_window(y);
+    const float* columns = colsum_.data();
+    int stride = w_;
+    if (win.half) {
+      half_weight_ends(y);
+      columns = col_.data() + hpad_lo_;
+      stride = col_stride_;
     }
+    const size_t pstride = prefix_stride_;
+    float* prefix = prefix_.data() + prefix_pad_;
+    prefix_scan(columns, stride, w_, prefix, pstride);
+    for (int c = 0; c < kChannels; ++c) {
+      float* pc = prefix + c * pstride;
+      std::fill(pc + w_, pc + w_ + win.hi, pc[w_ - 1]);
+    }
+    const size_t off = static_cast<size_t>(y) * w_;
+    WindowSolve ws{w_,
+                   prefix,
+                   pstride,
+                   win.half ? columns : nullptr,
+                   stride,
+                   win.lo,
+                   win.hi,
+                   p_.inv_cx.data(),
+                   1.f / p_.cy[y],
+                   p_.lambda};
+    solve_pixels(ws, u_old_ + off, v_old_ + off, u_new + off, v_new + off,
+                 confidence ? confidence + off : nullptr);
   }
 
  private:
@@ -549,7 +546,6 @@ class RowIterator {
   const float* v_old_;
   int w_, h_;
   int ring_rows_;
-  int padded_;
   RowScratch& scratch_;
   int first_ = 0, next_ = 0;
   WarpedRow* warp_cache_ = scratch_.warp_cache;
@@ -697,6 +693,94 @@ void median_filter(cv::Mat& u, cv::Mat& v, int ksize) {
   cv::medianBlur(v, v, ksize);
 }
 
+// Dense flow from pyramids with `ws`'s buffers (params already validated).
+void flow_from_pyramids(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkParams& params,
+                        FlowResult& result, const FlowOptions& options, Workspace& ws) {
+  const cv::Size size = pyr_t.size();
+  if (size.empty() || pyr_t1.size() != size) throw Error("pyramids are empty or differ in size");
+  const int levels = effective_levels(size, params.levels);
+  if (pyr_t.num_levels() < levels || pyr_t1.num_levels() < levels) {
+    throw Error("pyramid has " + std::to_string(std::min(pyr_t.num_levels(), pyr_t1.num_levels())) +
+                " levels, " + std::to_string(levels) + " needed");
+  }
+  const cv::Rect full(cv::Point(), size);
+  const cv::Rect region = options.region.empty() ? full : (options.region & full);
+  if (region.empty()) throw Error("flow region lies outside the frame");
+
+  const bool half_grid = params.derivative == Derivative::HornSchunck;
+  const Window win = make_window(params.patch, half_grid);
+  // Flow at a pixel after one iteration depends on the previous flow within the window plus
+  // the derivative stencil: computing on a margin of this many pixels per iteration makes a
+  // region's flow equal the whole frame's flow inside the region (up to rounding).
+  const int reach = win.reach() + 2;
+  const int margin =
+      params.iterations * reach + std::max(params.level_median, params.final_median) / 2;
+
+  std::vector<cv::Rect> comp(levels);
+  cv::Rect need = region;
+  for (int l = 0; l < levels; ++l) {
+    const cv::Rect level_rect(cv::Point(), pyr_t.levels[l].size());
+    comp[l] = expand(need, margin) & level_rect;
+    const cv::Rect& c = comp[l];
+    need = cv::Rect(cv::Point(c.x / 2, c.y / 2),
+                    cv::Point((c.x + c.width - 1) / 2 + 2, (c.y + c.height - 1) / 2 + 2));
+  }
+
+  const SerialExecutor serial;
+  const Executor& exec = options.executor ? *options.executor : serial;
+
+  for (auto* mats : {&ws.u, &ws.v, &ws.u_next, &ws.v_next})
+    mats->resize(levels);
+  // Level 0 computes the confidence straight into the result when the region is all of it.
+  const cv::Rect crop(region.tl() - comp[0].tl(), region.size());
+  cv::Mat& confidence = crop.size() == comp[0].size() ? result.confidence : ws.confidence;
+  for (int l = levels - 1; l >= 0; --l) {
+    const cv::Rect& c = comp[l];
+    cv::Mat& u = ws.u[l];
+    cv::Mat& v = ws.v[l];
+    if (l == levels - 1) {
+      const float scale = 1.f / static_cast<float>(1 << l);
+      u.create(c.size(), CV_32F);
+      v.create(c.size(), CV_32F);
+      u.setTo(options.initial_motion.x * scale);
+      v.setTo(options.initial_motion.y * scale);
+    } else {
+      upsample_flow(ws.u[l + 1], comp[l + 1].tl(), c, u);
+      upsample_flow(ws.v[l + 1], comp[l + 1].tl(), c, v);
+    }
+    LevelProblem p;
+    p.i0 = &pyr_t.levels[l];
+    p.i1 = &pyr_t1.levels[l];
+    p.comp = c;
+    p.derivative = params.derivative;
+    p.win = win;
+    p.lambda = static_cast<float>(params.lambda);
+    p.robust_inv_scale2 =
+        params.robust_scale > 0
+            ? static_cast<float>(1.0 / (params.robust_scale * params.robust_scale))
+            : 0.f;
+    // Windows are clipped at the computed rectangle; near the image border that is the
+    // image border, elsewhere only pixels outside the wanted region are affected.
+    p.inv_cx.resize(c.width);
+    for (int x = 0; x < c.width; ++x)
+      p.inv_cx[x] = 1.f / window_weight(win, x, c.width);
+    p.cy.resize(c.height);
+    for (int y = 0; y < c.height; ++y)
+      p.cy[y] = window_weight(win, y, c.height);
+    if (l == 0) confidence.create(c.size(), CV_32F);
+    iterate_level(p, u, v, ws.u_next[l], ws.v_next[l], l == 0 ? &confidence : nullptr,
+                  params.iterations, exec);
+    if (l > 0) median_filter(u, v, params.level_median);
+  }
+  median_filter(ws.u[0], ws.v[0], params.final_median);
+
+  const cv::Mat planes[] = {ws.u[0](crop), ws.v[0](crop)};
+  result.flow.create(crop.size(), CV_32FC2);
+  cv::merge(planes, 2, result.flow);
+  if (&confidence != &result.confidence) confidence(crop).copyTo(result.confidence);
+  result.region = region;
+}
+
 }  // namespace
 
 LkParams LkParams::paper() {
@@ -783,97 +867,14 @@ void dense_flow(const cv::Mat& frame_t, const cv::Mat& frame_t1, const LkParams&
   Workspace& ws = *lease;
   build_pyramid(frame_t, params.levels, params.sigma, ws.pyr_t);
   build_pyramid(frame_t1, params.levels, params.sigma, ws.pyr_t1);
-  dense_flow(ws.pyr_t, ws.pyr_t1, params, result, options);
+  flow_from_pyramids(ws.pyr_t, ws.pyr_t1, params, result, options, ws);
 }
 
 void dense_flow(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkParams& params,
                 FlowResult& result, const FlowOptions& options) {
   params.validate();
-  const cv::Size size = pyr_t.size();
-  if (size.empty() || pyr_t1.size() != size) throw Error("pyramids are empty or differ in size");
-  const int levels = effective_levels(size, params.levels);
-  if (pyr_t.num_levels() < levels || pyr_t1.num_levels() < levels) {
-    throw Error("pyramid has " + std::to_string(std::min(pyr_t.num_levels(), pyr_t1.num_levels())) +
-                " levels, " + std::to_string(levels) + " needed");
-  }
-  const cv::Rect full(cv::Point(), size);
-  const cv::Rect region = options.region.empty() ? full : (options.region & full);
-  if (region.empty()) throw Error("flow region lies outside the frame");
-
-  const bool half_grid = params.derivative == Derivative::HornSchunck;
-  const Window win = make_window(params.patch, half_grid);
-  // Flow at a pixel after one iteration depends on the previous flow within the window plus
-  // the derivative stencil: computing on a margin of this many pixels per iteration makes a
-  // region's flow equal the whole frame's flow inside the region (up to rounding).
-  const int reach = win.reach() + 2;
-  const int margin =
-      params.iterations * reach + std::max(params.level_median, params.final_median) / 2;
-
-  std::vector<cv::Rect> comp(levels);
-  cv::Rect need = region;
-  for (int l = 0; l < levels; ++l) {
-    const cv::Rect level_rect(cv::Point(), pyr_t.levels[l].size());
-    comp[l] = expand(need, margin) & level_rect;
-    const cv::Rect& c = comp[l];
-    need = cv::Rect(cv::Point(c.x / 2, c.y / 2),
-                    cv::Point((c.x + c.width - 1) / 2 + 2, (c.y + c.height - 1) / 2 + 2));
-  }
-
-  const SerialExecutor serial;
-  const Executor& exec = options.executor ? *options.executor : serial;
-
   WorkspaceLease lease;
-  Workspace& ws = *lease;
-  for (auto* mats : {&ws.u, &ws.v, &ws.u_next, &ws.v_next})
-    mats->resize(levels);
-  // Level 0 computes the confidence straight into the result when the region is all of it.
-  const cv::Rect crop(region.tl() - comp[0].tl(), region.size());
-  cv::Mat& confidence = crop.size() == comp[0].size() ? result.confidence : ws.confidence;
-  for (int l = levels - 1; l >= 0; --l) {
-    const cv::Rect& c = comp[l];
-    cv::Mat& u = ws.u[l];
-    cv::Mat& v = ws.v[l];
-    if (l == levels - 1) {
-      const float scale = 1.f / static_cast<float>(1 << l);
-      u.create(c.size(), CV_32F);
-      v.create(c.size(), CV_32F);
-      u.setTo(options.initial_motion.x * scale);
-      v.setTo(options.initial_motion.y * scale);
-    } else {
-      upsample_flow(ws.u[l + 1], comp[l + 1].tl(), c, u);
-      upsample_flow(ws.v[l + 1], comp[l + 1].tl(), c, v);
-    }
-    LevelProblem p;
-    p.i0 = &pyr_t.levels[l];
-    p.i1 = &pyr_t1.levels[l];
-    p.comp = c;
-    p.derivative = params.derivative;
-    p.win = win;
-    p.lambda = static_cast<float>(params.lambda);
-    p.robust_inv_scale2 =
-        params.robust_scale > 0
-            ? static_cast<float>(1.0 / (params.robust_scale * params.robust_scale))
-            : 0.f;
-    // Windows are clipped at the computed rectangle; near the image border that is the
-    // image border, elsewhere only pixels outside the wanted region are affected.
-    p.inv_cx.resize(c.width);
-    for (int x = 0; x < c.width; ++x)
-      p.inv_cx[x] = 1.f / window_weight(win, x, c.width);
-    p.cy.resize(c.height);
-    for (int y = 0; y < c.height; ++y)
-      p.cy[y] = window_weight(win, y, c.height);
-    if (l == 0) confidence.create(c.size(), CV_32F);
-    iterate_level(p, u, v, ws.u_next[l], ws.v_next[l], l == 0 ? &confidence : nullptr,
-                  params.iterations, exec);
-    if (l > 0) median_filter(u, v, params.level_median);
-  }
-  median_filter(ws.u[0], ws.v[0], params.final_median);
-
-  const cv::Mat planes[] = {ws.u[0](crop), ws.v[0](crop)};
-  result.flow.create(crop.size(), CV_32FC2);
-  cv::merge(planes, 2, result.flow);
-  if (&confidence != &result.confidence) confidence(crop).copyTo(result.confidence);
-  result.region = region;
+  flow_from_pyramids(pyr_t, pyr_t1, params, result, options, *lease);
 }
 
 FlowResult dense_flow(const cv::Mat& frame_t, const cv::Mat& frame_t1, const LkParams& params,
