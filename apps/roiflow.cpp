@@ -164,12 +164,15 @@ fs::path partial_path(const fs::path& path) {
   return partial;
 }
 
-// Written next to the target, then renamed over it: a reader never sees half a file.
-void write_image(const std::string& path, const cv::Mat& image) {
+// `write(partial)` writes next to the target, which is then renamed over it: a reader never
+// sees half a file, and a failed write leaves nothing behind.
+// `what` names the kind of file in the error message ("image ", or empty).
+template <class Write>
+void write_atomically(const std::string& path, const std::string& what, Write&& write) {
   const fs::path partial = partial_path(path);
   bool written = false;
   try {
-    written = cv::imwrite(partial.string(), image);
+    written = write(partial.string());
   } catch (const cv::Exception&) {
     written = false;
   }
@@ -177,21 +180,22 @@ void write_image(const std::string& path, const cv::Mat& image) {
   if (written) fs::rename(partial, path, ec);
   if (!written || ec) {
     fs::remove(partial, ec);
-    throw Error("cannot write image '" + path + "'");
+    throw Error("cannot write " + what + "'" + path + "'");
   }
 }
 
+void write_image(const std::string& path, const cv::Mat& image) {
+  write_atomically(path, "image ",
+                   [&](const std::string& partial) { return cv::imwrite(partial, image); });
+}
+
 void write_text(const std::string& path, const std::string& text) {
-  const fs::path partial = partial_path(path);
-  std::ofstream out(partial, std::ios::binary);
-  out << text;
-  out.close();
-  std::error_code ec;
-  if (out) fs::rename(partial, path, ec);
-  if (!out || ec) {
-    fs::remove(partial, ec);
-    throw Error("cannot write '" + path + "'");
-  }
+  write_atomically(path, "", [&](const std::string& partial) {
+    std::ofstream out(partial, std::ios::binary);
+    out << text;
+    out.close();
+    return static_cast<bool>(out);
+  });
 }
 
 // ---------------------------------------------------------------------------------------------
