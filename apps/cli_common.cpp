@@ -1,0 +1,156 @@
+#include "cli_common.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+
+#include "flow/pyramid.hpp"
+#include "pipeline/tbb_executor.hpp"
+
+namespace roiflow::cli {
+
+namespace fs = std::filesystem;
+
+// ---------------------------------------------------------------------------------------------
+// Shared Lucas-Kanade options
+
+void add_lk_options(CLI::App& cmd, LkOptions& lk) {
+  const std::string group = "Lucas-Kanade parameters (default: the preset's)";
+  cmd.add_option("--preset", lk.preset, "parameter set the options below override")
+      ->type_name("NAME")
+      ->check(CLI::IsMember(flow::LkParams::preset_names()))
+      ->capture_default_str()
+      ->group(group);
+  cmd.add_option("--patch", lk.patch, "window side in pixels")
+      ->check(CLI::Range(3, 31))
+      ->group(group);
+  cmd.add_option("--levels", lk.levels, "pyramid levels")
+      ->check(CLI::Range(1, flow::kMaxLevels))
+      ->group(group);
+  cmd.add_option("--iterations", lk.iterations, "refinement iterations per level")
+      ->check(CLI::Range(1, 50))
+      ->group(group);
+  cmd.add_option("--sigma", lk.sigma, "pretreatment Gaussian sigma in pixels, 0..20 (0 = off)")
+      ->group(group);
+  cmd.add_option("--lambda", lk.lambda, "Tikhonov weight, (0, 1]")->group(group);
+  cmd.add_option("--derivative", lk.derivative, "image derivatives")
+      ->type_name("NAME")
+      ->check(CLI::IsMember({"hs", "scharr", "central"}))
+      ->group(group);
+  cmd.add_option("--robust-scale", lk.robust_scale,
+                 "Cauchy reweighting scale of the residuals, 0..1 (0 = plain least squares)")
+      ->group(group);
+  cmd.add_option("--level-median", lk.level_median,
+                 "median filter of the flow after each coarse level (0 = off)")
+      ->check(CLI::IsMember({0, 3, 5}))
+      ->group(group);
+  cmd.add_option("--final-median", lk.final_median, "median filter of the final flow (0 = off)")
+      ->check(CLI::IsMember({0, 3, 5}))
+      ->group(group);
+  cmd.add_option("--threads", lk.threads, "worker threads")
+      ->check(CLI::Range(1, pipeline::kMaxThreads))
+      ->capture_default_str()
+      ->group(group);
+}
+
+flow::LkParams lk_params(const LkOptions& lk) {
+  flow::LkParams params = flow::LkParams::preset(lk.preset);
+  if (lk.patch) params.patch = *lk.patch;
+  if (lk.levels) params.levels = *lk.levels;
+  if (lk.iterations) params.iterations = *lk.iterations;
+  if (lk.sigma) params.sigma = *lk.sigma;
+  if (lk.lambda) params.lambda = *lk.lambda;
+  if (lk.derivative) params.derivative = flow::derivative_from_string(*lk.derivative);
+  if (lk.robust_scale) params.robust_scale = *lk.robust_scale;
+  if (lk.level_median) params.level_median = *lk.level_median;
+  if (lk.final_median) params.final_median = *lk.final_median;
+  try {
+    params.validate();
+  } catch (const Error& e) {
+    throw UsageError(e.what());
+  }
+  return params;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Output helpers
+
+std::string size_string(cv::Size size) {
+  return std::to_string(size.width) + "x" + std::to_string(size.height);
+}
+
+std::string fixed(double value, int decimals) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
+  return buffer;
+}
+
+std::string errors_line(const flow::FlowErrors& e) {
+  return "AAE " + fixed(e.aae_deg, 3) + " deg, EPE " + fixed(e.epe, 4) + " px, R1 " +
+         fixed(e.r1, 2) + " %, R3 " + fixed(e.r3, 2) + " %";
+}
+
+void check_output_path(const std::string& path, const std::string& option) {
+  const fs::path parent = fs::path(path).parent_path();
+  std::error_code ec;
+  if (!parent.empty() && !fs::is_directory(parent, ec)) {
+    throw Error(option + ": directory '" + parent.string() + "' of '" + path + "' does not exist");
+  }
+  if (fs::is_directory(path, ec)) throw Error(option + ": '" + path + "' is a directory");
+}
+
+void check_image_output(const std::string& path, const std::string& option) {
+  check_output_path(path, option);
+  if (!cv::haveImageWriter(path)) {
+    throw UsageError(option + ": cannot write an image named '" + path +
+                     "' (use an extension such as .png)");
+  }
+}
+
+namespace {
+
+// The partial file keeps the extension, from which cv::imwrite picks the format.
+fs::path partial_path(const fs::path& path) {
+  fs::path partial = path;
+  partial.replace_filename("." + path.stem().string() + ".partial" + path.extension().string());
+  return partial;
+}
+
+// `write(partial)` writes next to the target, which is then renamed over it: a reader never
+// sees half a file, and a failed write leaves nothing behind.
+// `what` names the kind of file in the error message ("image ", or empty).
+template <class Write>
+void write_atomically(const std::string& path, const std::string& what, Write&& write) {
+  const fs::path partial = partial_path(path);
+  bool written = false;
+  try {
+    written = write(partial.string());
+  } catch (const cv::Exception&) {
+    written = false;
+  }
+  std::error_code ec;
+  if (written) fs::rename(partial, path, ec);
+  if (!written || ec) {
+    fs::remove(partial, ec);
+    throw Error("cannot write " + what + "'" + path + "'");
+  }
+}
+
+}  // namespace
+
+void write_image(const std::string& path, const cv::Mat& image) {
+  write_atomically(path, "image ",
+                   [&](const std::string& partial) { return cv::imwrite(partial, image); });
+}
+
+void write_text(const std::string& path, const std::string& text) {
+  write_atomically(path, "", [&](const std::string& partial) {
+    std::ofstream out(partial, std::ios::binary);
+    out << text;
+    out.close();
+    return static_cast<bool>(out);
+  });
+}
+
+}  // namespace roiflow::cli

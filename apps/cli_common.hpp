@@ -1,0 +1,49 @@
+// Pieces the roiflow subcommands share: the usage error, the Lucas-Kanade options, output
+// checks and atomic writes, number formatting.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+
+#include "flow/dense_lk.hpp"
+#include "flow/error.hpp"
+#include "flow/metrics.hpp"
+
+namespace roiflow::cli {
+
+// A command line that CLI11 accepts but that makes no sense (conflicting inputs, LK
+// parameters out of range): reported like CLI11's own parse errors, with exit code 2.
+class UsageError : public Error {
+ public:
+  using Error::Error;
+};
+
+// Overrides stay empty unless given, so they apply on top of whichever preset was chosen.
+struct LkOptions {
+  std::string preset = "paper";
+  std::optional<int> patch, levels, iterations, level_median, final_median;
+  std::optional<double> sigma, lambda, robust_scale;
+  std::optional<std::string> derivative;
+  int threads = 1;
+};
+
+void add_lk_options(CLI::App& cmd, LkOptions& lk);
+// The preset with the overrides applied; out-of-range values throw UsageError.
+flow::LkParams lk_params(const LkOptions& lk);
+
+std::string size_string(cv::Size size);
+std::string fixed(double value, int decimals);
+std::string errors_line(const flow::FlowErrors& e);
+
+// Catches a mistyped output path before minutes of computation are spent.
+void check_output_path(const std::string& path, const std::string& option);
+void check_image_output(const std::string& path, const std::string& option);
+
+// Written next to the target and renamed over it: a reader never sees half a file, and a
+// failed write leaves nothing behind.
+void write_image(const std::string& path, const cv::Mat& image);
+void write_text(const std::string& path, const std::string& text);
+
+}  // namespace roiflow::cli

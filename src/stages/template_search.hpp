@@ -1,0 +1,40 @@
+// Template search: where a known appearance is in an image, by normalised cross-correlation.
+//
+//   using namespace roiflow::stages;
+//   TemplateMatch m = match_template(gray, target_patch, search_rect, {0.95, 1.0, 1.05});
+//   if (m.score > 0.6) box = m.box;   // sub-pixel top-left, size = template size x best scale
+//
+// For every scale the template is resized (area interpolation when shrinking, linear when
+// growing) and matched with OpenCV's TM_CCOEFF_NORMED (zero-mean NCC, in [-1, 1]) at every
+// position where it lies wholly inside `search` (clipped to the image). The best position gets
+// a parabolic sub-pixel refinement in x and y. A search region too small for a scaled template
+// skips that scale; if every scale is skipped the result has score -1 and an empty box.
+//
+// Large templates are searched coarse to fine: when the template's shorter side exceeds
+// `coarse_side`, image and template are first shrunk so that it is about `coarse_side` pixels,
+// the best coarse position is found over the whole region, and only a small window around it is
+// searched at full resolution. That keeps a whole-frame re-detection in the milliseconds.
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <vector>
+
+namespace roiflow::stages {
+
+struct TemplateMatch {
+  cv::Rect2f box;     // in image coordinates
+  double score = -1;  // NCC of the best match, -1 when nothing was searched
+  double scale = 1;   // the scale (of those given) that won
+};
+
+struct TemplateSearchParams {
+  std::vector<double> scales{1.0};  // template scale factors to try, each > 0
+  int coarse_side = 24;             // coarse-to-fine above this template side; 0 = never
+};
+
+// `image` and `templ`: 8-bit or float single channel (the same depth). Throws roiflow::Error on
+// empty or multi-channel inputs, mixed depths or a non-positive scale.
+TemplateMatch match_template(const cv::Mat& image, const cv::Mat& templ, const cv::Rect& search,
+                             const TemplateSearchParams& params = {});
+
+}  // namespace roiflow::stages
