@@ -1,0 +1,82 @@
+// GlobalDetector: the paper's global treatment — find the moving object in the whole frame.
+//
+//   using namespace roiflow::stages;
+//   GlobalDetector detector;
+//   while (auto f = source.next()) {
+//     detector.observe(f->image);                         // every frame: background model
+//     if (!tracking) {
+//       auto objects = detector.moving_objects();         // biggest first
+//       if (!objects.empty()) detector.set_target(f->image, objects[0].box), tracking = true;
+//     } else if (lost) {
+//       auto found = detector.find_target(f->image, f->gray, predicted_centre, by_appearance);
+//     }
+//   }
+//
+// Two ways to find an object:
+//  - fixed camera, nothing known: a background model updated by observe() (OpenCV's MOG2 on a
+//    reduced copy of the frame, so that keeping it up to date every frame costs little), the
+//    foreground mask cleaned by morphology, its external contours, and for each object the
+//    bounding box and the barycentre of its edge contour. Objects below `min_area` are noise.
+//  - known object (the target was given as a box, OTB protocol, or the camera moves): its
+//    appearance — the template captured by set_target() — searched over the whole frame by
+//    multi-scale normalised cross-correlation (stages/template_search.hpp).
+// The target's signature (colour histogram, edge-shape moments, size) picks, among the moving
+// objects, the one that is the target when it is found again by background subtraction.
+#pragma once
+
+#include <memory>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <vector>
+
+namespace roiflow::stages {
+
+struct GlobalDetectorParams {
+  int history = 100;       // frames the background model remembers (MOG2 history), >= 2
+  int warmup = 3;          // moving_objects() stays empty for this many observed frames
+  int work_width = 320;    // the background model works on frames shrunk to this width
+                           // (never enlarged); 0 = full resolution
+  double min_area = 64;    // smallest object, in full-resolution pixels
+  double min_score = 0.5;  // a re-detection below this similarity is no detection, (0, 1)
+  std::vector<double> appearance_scales{0.8, 0.9, 1.0, 1.1, 1.25};  // relative to the target's
+                                                                    // last known size
+  void validate() const;  // throws roiflow::Error naming the bad value
+};
+
+struct Detection {
+  cv::Rect2f box;          // full-resolution pixels
+  cv::Point2f barycentre;  // of the object's edge contour (the paper's object position)
+  double score = 0;        // moving_objects: area in pixels; find_target: similarity in [0, 1]
+};
+
+class GlobalDetector {
+ public:
+  explicit GlobalDetector(const GlobalDetectorParams& params = {});
+
+  // Updates the background model with a frame (8-bit BGR or gray, one size for a run). Call it
+  // for every frame, in order, whether or not detection is needed on that frame.
+  void observe(const cv::Mat& image);
+  // Moving objects of the last observed frame, biggest first; empty during warm-up.
+  std::vector<Detection> moving_objects() const;
+
+  // Remembers the target: its template (gray), signature and size, from `image` (8-bit BGR or
+  // gray) at `box` (clipped to the frame; throws roiflow::Error when nothing is left).
+  void set_target(const cv::Mat& image, const cv::Rect2f& box);
+  bool has_target() const;
+  cv::Size2f target_size() const;  // the size last given to set_target
+  // Updates the expected size of the target (the tracker follows its scale) without changing
+  // the appearance captured by set_target.
+  void set_target_size(cv::Size2f size);
+
+  // Finds the target in the whole frame: by appearance (multi-scale NCC of the template) when
+  // `by_appearance`, else among the moving objects by signature similarity (the nearest to
+  // `near` breaks ties). std::nullopt when nothing reaches `min_score`, or without a target.
+  std::optional<Detection> find_target(const cv::Mat& image, const cv::Mat& gray, cv::Point2f near,
+                                       bool by_appearance) const;
+
+ private:
+  struct Impl;
+  std::shared_ptr<Impl> impl_;
+};
+
+}  // namespace roiflow::stages

@@ -1,0 +1,518 @@
+#include "stages/local_tracker.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+#include <utility>
+
+#include "flow/error.hpp"
+#include "stages/template_search.hpp"
+
+namespace roiflow::stages {
+namespace {
+
+std::string num(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+void check_range(const char* name, double value, double lo, double hi) {
+  if (!(value >= lo && value <= hi)) {
+    throw Error(std::string("local tracker: ") + name + " must be in [" + num(lo) + ", " + num(hi) +
+                "], got " + num(value));
+  }
+}
+
+cv::Point2f centre(const cv::Rect2f& r) {
+  return {r.x + 0.5f * r.width, r.y + 0.5f * r.height};
+}
+
+cv::Rect2f box_at(cv::Point2f c, cv::Size2f s) {
+  return {c.x - 0.5f * s.width, c.y - 0.5f * s.height, s.width, s.height};
+}
+
+// Smallest integer rectangle holding `r`.
+cv::Rect enclosing(const cv::Rect2f& r) {
+  const int x0 = static_cast<int>(std::floor(r.x));
+  const int y0 = static_cast<int>(std::floor(r.y));
+  const int x1 = static_cast<int>(std::ceil(r.x + r.width));
+  const int y1 = static_cast<int>(std::ceil(r.y + r.height));
+  return {x0, y0, x1 - x0, y1 - y0};
+}
+
+// Median by partial sort; reorders `v`, which must not be empty.
+float median(std::vector<float>& v) {
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+// Bilinear sample of a CV_32FC2 field at (x, y), false outside its last full 2x2 cell.
+bool sample(const cv::Mat& field, float x, float y, cv::Vec2f& out) {
+  if (!(x >= 0.f && y >= 0.f)) return false;
+  const int ix = static_cast<int>(x);
+  const int iy = static_cast<int>(y);
+  if (ix + 1 >= field.cols || iy + 1 >= field.rows) return false;
+  const float ax = x - static_cast<float>(ix);
+  const float ay = y - static_cast<float>(iy);
+  const cv::Vec2f* r0 = field.ptr<cv::Vec2f>(iy) + ix;
+  const cv::Vec2f* r1 = field.ptr<cv::Vec2f>(iy + 1) + ix;
+  out = (1.f - ay) * ((1.f - ax) * r0[0] + ax * r0[1]) + ay * ((1.f - ax) * r1[0] + ax * r1[1]);
+  return true;
+}
+
+// Vertex abscissa of the parabola through three points, clamped to [x0, x2]; x1 when the three
+// do not make a maximum.
+double parabola_vertex(double x0, double y0, double x1, double y1, double x2, double y2) {
+  const double d01 = (y1 - y0) / (x1 - x0);
+  const double d12 = (y2 - y1) / (x2 - x1);
+  const double curvature = (d12 - d01) / (x2 - x0);
+  if (!(curvature < 0.0) || !std::isfinite(curvature)) return x1;
+  const double vertex = 0.5 * (x0 + x1) - d01 / (2.0 * curvature);
+  return std::clamp(vertex, x0, x2);
+}
+
+// Deterministic pair sampling for the scale estimate (xorshift32: the same pairs everywhere).
+class PairSampler {
+ public:
+  std::uint32_t next() {
+    state_ ^= state_ << 13;
+    state_ ^= state_ >> 17;
+    state_ ^= state_ << 5;
+    return state_;
+  }
+
+ private:
+  std::uint32_t state_ = 2463534242u;
+};
+
+// Relative size change per frame that the motion-consistency test of the scale estimate allows.
+constexpr float kScaleTolerance = 0.05f;
+// The largest size change accepted between two frames.
+constexpr double kMaxScaleChange = 1.25;
+
+// The appearance at `b` in level 0 of `pyr`, sub-pixel placed (pixel i covers [i, i + 1), so
+// the box's centre is at pixel coordinate c - 0.5).
+void cut(const flow::Pyramid& pyr, const cv::Rect2f& b, cv::Mat& out) {
+  const cv::Point2f c = centre(b);
+  cv::getRectSubPix(
+      pyr.levels[0],
+      cv::Size(static_cast<int>(std::lround(b.width)), static_cast<int>(std::lround(b.height))),
+      cv::Point2f(c.x - 0.5f, c.y - 0.5f), out, CV_32F);
+}
+
+// The best appearance match around a box: centre and size in level-0 pixels, and its NCC.
+struct Appearance {
+  double score = -1;
+  cv::Point2f centre;
+  double size_ratio = 1;  // matched size / the box's size
+  bool at_edge = false;   // the best match touches the search window inside the image: the
+                          // real peak may lie beyond it
+};
+
+}  // namespace
+
+void LocalTrackerParams::validate() const {
+  check_range("roi", roi, 8, 4096);
+  lk.validate();
+  check_range("max_points", max_points, 16, 1e6);
+  check_range("fb_levels", fb_levels, 1, flow::kMaxLevels);
+  if (!(fb_threshold > 0) || !std::isfinite(fb_threshold)) {
+    throw Error("local tracker: fb_threshold must be > 0, got " + num(fb_threshold));
+  }
+  if (!(min_inliers >= 0 && min_inliers < 1)) {
+    throw Error("local tracker: min_inliers must be in [0, 1), got " + num(min_inliers));
+  }
+  if (!(min_texture >= 0) || !std::isfinite(min_texture)) {
+    throw Error("local tracker: min_texture must be >= 0, got " + num(min_texture));
+  }
+  if (!(min_appearance >= -1 && min_appearance < 1)) {
+    throw Error("local tracker: min_appearance must be in [-1, 1), got " + num(min_appearance));
+  }
+  check_range("trust_appearance", trust_appearance, min_appearance, 1);
+  check_range("appearance_weight", appearance_weight, 0, 1);
+  if (!(search > 0 && search <= 2)) {
+    throw Error("local tracker: search must be in (0, 2], got " + num(search));
+  }
+  if (!(scale_step > 0 && scale_step < 0.5)) {
+    throw Error("local tracker: scale_step must be in (0, 0.5), got " + num(scale_step));
+  }
+  check_range("scale_steps", scale_steps, 0, 10);
+  check_range("match_side", match_side, 8, 256);
+  check_range("template_interval", template_interval, 1, 1e9);
+  check_range("velocity_gain", velocity_gain, 0, 1);
+}
+
+const char* to_string(LostReason reason) {
+  switch (reason) {
+    case LostReason::Found:
+      return "found";
+    case LostReason::FewInliers:
+      return "few-inliers";
+    case LostReason::LowTexture:
+      return "low-texture";
+    case LostReason::Appearance:
+      return "appearance";
+    case LostReason::LeftRegion:
+      return "left-region";
+  }
+  return "?";
+}
+
+struct LocalTracker::Impl {
+  LocalTrackerParams params;
+  const flow::Executor* executor = nullptr;
+  std::shared_ptr<const flow::Pyramid> prev;
+  cv::Rect2f box;
+  cv::Point2f velocity;
+  cv::Mat templ;   // CV_32FC1 appearance at level 0, cut at the box given to start()
+  cv::Mat recent;  // the same, cut at a recent confidently tracked box (empty until then)
+  int since_recent = 0;
+
+  // Buffers reused from frame to frame.
+  flow::FlowResult forward;
+  flow::FlowResult backward;
+  std::vector<cv::Point2f> from, to;
+  std::vector<float> conf, work_x, work_y;
+  std::vector<int> inliers, consistent;
+
+  void place(std::shared_ptr<const flow::Pyramid> pyramid, const cv::Rect2f& b) {
+    if (!pyramid || pyramid->levels.empty()) throw Error("local tracker: empty pyramid");
+    if (!(std::isfinite(b.x) && std::isfinite(b.y) && b.width >= 2 && b.height >= 2 &&
+          std::isfinite(b.width) && std::isfinite(b.height))) {
+      throw Error("local tracker: box (" + num(b.x) + ", " + num(b.y) + ", " + num(b.width) +
+                  " x " + num(b.height) + ") must be finite with sides of at least 2 pixels");
+    }
+    const cv::Size size = pyramid->size();
+    const cv::Rect inside = enclosing(b) & cv::Rect(cv::Point(), size);
+    if (inside.width < 2 || inside.height < 2) {
+      throw Error("local tracker: box (" + num(b.x) + ", " + num(b.y) + ", " + num(b.width) +
+                  " x " + num(b.height) + ") leaves nothing inside the " + num(size.width) + " x " +
+                  num(size.height) + " frame");
+    }
+    prev = std::move(pyramid);
+    box = b;
+    velocity = {0.f, 0.f};
+  }
+
+  Appearance match(const cv::Mat& appearance, const flow::Pyramid& pyr, const cv::Rect2f& b,
+                   double reach) const;
+  cv::Point2f measure_motion(double& scale);
+  LocalResult track(std::shared_ptr<const flow::Pyramid> pyramid);
+};
+
+// The template matched at 2 * scale_steps + 1 scales around the box's size, on the finest level
+// where the object's shorter side is still at least match_side: NCC's cost grows with the
+// template's area, and a few dozen pixels across are plenty to place and size a whole object.
+Appearance LocalTracker::Impl::match(const cv::Mat& appearance, const flow::Pyramid& pyr,
+                                     const cv::Rect2f& b, double reach) const {
+  const double shorter = std::min(b.width, b.height);
+  int level = 0;
+  while (level + 1 < pyr.num_levels() && shorter / (2 << level) >= params.match_side)
+    ++level;
+  const double f = 1.0 / (1 << level);
+  const cv::Mat& image = pyr.levels[level];
+  // Level-k pixel i sits at level-0 pixel i * 2^k: convert through pixel-centre coordinates.
+  const cv::Point2f c0 = centre(b);
+  const cv::Point2f ck((c0.x - 0.5f) * static_cast<float>(f) + 0.5f,
+                       (c0.y - 0.5f) * static_cast<float>(f) + 0.5f);
+  const double radius = reach * std::max(3.0, params.search * shorter * f);
+  const double box_scale = std::sqrt(static_cast<double>(b.area()) / appearance.size().area());
+
+  const int n = 2 * params.scale_steps + 1;
+  std::vector<TemplateMatch> found(n);
+  std::vector<double> log_scale(n);
+  std::vector<cv::Rect> windows(n);
+  int best = -1;
+  TemplateSearchParams tp;
+  tp.coarse_side = 0;
+  for (int j = 0; j < n; ++j) {
+    const double ratio = std::pow(1.0 + params.scale_step, j - params.scale_steps);
+    tp.scales = {box_scale * ratio * f};
+    const double half_w = 0.5 * appearance.cols * tp.scales[0] + radius;
+    const double half_h = 0.5 * appearance.rows * tp.scales[0] + radius;
+    const cv::Rect window =
+        enclosing(cv::Rect2f(static_cast<float>(ck.x - half_w), static_cast<float>(ck.y - half_h),
+                             static_cast<float>(2 * half_w), static_cast<float>(2 * half_h)));
+    found[j] = match_template(image, appearance, window, tp);
+    windows[j] = window & cv::Rect(cv::Point(), image.size());
+    // The size really matched: match_template rounds the scaled template to whole pixels.
+    log_scale[j] = found[j].score > -1 ? 0.5 * std::log(static_cast<double>(found[j].box.area()) /
+                                                        (appearance.size().area() * f * f))
+                                       : 0.0;
+    if (found[j].score > -1 && (best < 0 || found[j].score > found[best].score)) best = j;
+  }
+  Appearance a;
+  if (best < 0) return a;
+  a.score = found[best].score;
+  double log_s = log_scale[best];
+  if (best > 0 && best + 1 < n && found[best - 1].score > -1 && found[best + 1].score > -1 &&
+      log_scale[best - 1] < log_s && log_s < log_scale[best + 1]) {
+    log_s = parabola_vertex(log_scale[best - 1], found[best - 1].score, log_s, found[best].score,
+                            log_scale[best + 1], found[best + 1].score);
+  }
+  a.size_ratio = std::exp(log_s) / box_scale;
+  const cv::Rect2f& m = found[best].box;
+  const cv::Rect& w = windows[best];
+  a.at_edge = (m.x < w.x + 1.f && w.x > 0) || (m.y < w.y + 1.f && w.y > 0) ||
+              (m.br().x > static_cast<float>(w.br().x) - 1.f && w.br().x < image.cols) ||
+              (m.br().y > static_cast<float>(w.br().y) - 1.f && w.br().y < image.rows);
+  const cv::Point2f mk = centre(m);
+  a.centre = cv::Point2f(static_cast<float>((mk.x - 0.5) / f + 0.5),
+                         static_cast<float>((mk.y - 0.5) / f + 0.5));
+  return a;
+}
+
+LocalResult LocalTracker::Impl::track(std::shared_ptr<const flow::Pyramid> pyramid) {
+  if (!prev) throw Error("local tracker: track() before start()");
+  if (!pyramid || pyramid->size() != prev->size()) {
+    const cv::Size got = pyramid ? pyramid->size() : cv::Size();
+    throw Error("local tracker: frame is " + num(got.width) + " x " + num(got.height) +
+                ", the previous one was " + num(prev->size().width) + " x " +
+                num(prev->size().height));
+  }
+  const flow::Pyramid& cur = *pyramid;
+  const cv::Rect frame(cv::Point(), cur.size());
+  const cv::Rect2f predicted_box(box.x + velocity.x, box.y + velocity.y, box.width, box.height);
+
+  LocalResult r;
+  r.velocity = velocity;
+  auto lose = [&](LostReason why) {
+    r.lost = true;
+    r.reason = why;
+    r.box = predicted_box;
+    box = predicted_box;
+    prev = pyramid;
+    return r;
+  };
+
+  // The region holds the object now and where it is predicted next, at least roi x roi.
+  if (params.whole_frame) {
+    r.region = frame;
+  } else {
+    cv::Rect span = enclosing(box) | enclosing(predicted_box);
+    const int grow_x = std::max(0, params.roi - span.width);
+    const int grow_y = std::max(0, params.roi - span.height);
+    span = cv::Rect(span.x - grow_x / 2, span.y - grow_y / 2, span.width + grow_x,
+                    span.height + grow_y);
+    r.region = span & frame;
+  }
+  const cv::Rect object = enclosing(box) & r.region;
+  if (object.width < 2 || object.height < 2) return lose(LostReason::LeftRegion);
+
+  flow::FlowOptions opt;
+  opt.region = r.region;
+  opt.initial_motion = velocity;
+  opt.executor = executor;
+  flow::dense_flow(*prev, cur, params.lk, forward, opt);
+  r.region_flow = forward.flow.clone();
+
+  // A regular grid over the object's pixels, in frame t-1, and where the flow takes them.
+  const int step = std::max(1, static_cast<int>(std::ceil(std::sqrt(
+                                   static_cast<double>(object.area()) / params.max_points))));
+  from.clear();
+  to.clear();
+  conf.clear();
+  work_x.clear();
+  work_y.clear();
+  const int off_x = (object.width - 1) % step / 2;
+  const int off_y = (object.height - 1) % step / 2;
+  for (int y = object.y + off_y; y < object.y + object.height; y += step) {
+    const cv::Vec2f* fr = forward.flow.ptr<cv::Vec2f>(y - r.region.y);
+    const float* cr = forward.confidence.ptr<float>(y - r.region.y);
+    for (int x = object.x + off_x; x < object.x + object.width; x += step) {
+      const cv::Vec2f f = fr[x - r.region.x];
+      from.emplace_back(static_cast<float>(x), static_cast<float>(y));
+      to.emplace_back(static_cast<float>(x) + f[0], static_cast<float>(y) + f[1]);
+      conf.push_back(cr[x - r.region.x]);
+      work_x.push_back(f[0]);
+      work_y.push_back(f[1]);
+    }
+  }
+  const cv::Point2f rough(median(work_x), median(work_y));
+  r.texture = median(conf);
+
+  // Backward LK around where the object went, seeded with the reverse of its rough motion.
+  if (params.whole_frame) {
+    opt.region = frame;
+  } else {
+    const int pad = 2 + static_cast<int>(std::ceil(params.fb_threshold));
+    cv::Rect2f moved(static_cast<float>(object.x) + rough.x, static_cast<float>(object.y) + rough.y,
+                     static_cast<float>(object.width), static_cast<float>(object.height));
+    const cv::Rect b = enclosing(moved);
+    opt.region = cv::Rect(b.x - pad, b.y - pad, b.width + 2 * pad, b.height + 2 * pad) & frame;
+  }
+  opt.initial_motion = -rough;
+  inliers.clear();
+  if (!opt.region.empty()) {
+    flow::LkParams back_lk = params.lk;
+    back_lk.levels = std::min(params.lk.levels, params.fb_levels);
+    flow::dense_flow(cur, *prev, back_lk, backward, opt);
+    const cv::Point2f origin(static_cast<float>(backward.region.x),
+                             static_cast<float>(backward.region.y));
+    const float limit2 = static_cast<float>(params.fb_threshold * params.fb_threshold);
+    for (std::size_t i = 0; i < from.size(); ++i) {
+      cv::Vec2f back;
+      const cv::Point2f q = to[i] - origin;
+      if (!sample(backward.flow, q.x, q.y, back)) continue;
+      const float ex = to[i].x + back[0] - from[i].x;
+      const float ey = to[i].y + back[1] - from[i].y;
+      if (ex * ex + ey * ey <= limit2) inliers.push_back(static_cast<int>(i));
+    }
+  }
+  r.inliers = static_cast<double>(inliers.size()) / static_cast<double>(from.size());
+  LostReason flow_failure = LostReason::Found;
+  if (inliers.size() < 3 || r.inliers < params.min_inliers) {
+    flow_failure = LostReason::FewInliers;
+  } else if (r.texture < params.min_texture) {
+    flow_failure = LostReason::LowTexture;
+  }
+
+  cv::Point2f c = centre(predicted_box);
+  double scale = 1.0;
+  if (flow_failure == LostReason::Found) {
+    const cv::Point2f motion = measure_motion(scale);
+    c = centre(box) + motion;
+  }
+
+  // The first appearance never drifts, so it is preferred; a recent one takes over while the
+  // object looks different (lighting, pose) and the first no longer matches well. Where the flow
+  // failed (a sudden change of lighting breaks brightness constancy, an occlusion hides part of
+  // the object) the appearance alone may still find it near the prediction, over a wider search.
+  const cv::Rect2f flow_box = box_at(c, box.size() * static_cast<float>(scale));
+  const double reach = flow_failure == LostReason::Found ? 1.0 : 2.0;
+  Appearance a = match(templ, cur, flow_box, reach);
+  if (a.score < params.trust_appearance && !recent.empty()) {
+    const Appearance b = match(recent, cur, flow_box, reach);
+    if (b.score > a.score) a = b;
+  }
+  r.appearance = a.score;
+  // No score at all means no scale of the template fitted inside the frame (an object partly
+  // out of view): that is no evidence against the flow's measurement.
+  const bool matched = a.score > -1;
+  if (flow_failure != LostReason::Found) {
+    if (a.score < params.trust_appearance || a.at_edge) return lose(flow_failure);
+    c = a.centre;
+    scale = a.size_ratio;
+  } else if (matched && a.score < params.min_appearance) {
+    return lose(LostReason::Appearance);
+  } else if (a.score >= params.trust_appearance && !a.at_edge) {
+    const auto w = static_cast<float>(params.appearance_weight);
+    c = (1.f - w) * c + w * a.centre;
+    scale *= std::pow(a.size_ratio, params.appearance_weight);
+  }
+  if (!cv::Rect2f(r.region).contains(c)) return lose(LostReason::LeftRegion);
+  // Between two frames a real object changes size by far less than this; a larger estimate is a
+  // failed measurement, and a box must never collapse to nothing.
+  scale = std::clamp(scale, 1.0 / kMaxScaleChange, kMaxScaleChange);
+  if (std::min(box.width, box.height) * scale < 2.0) scale = 1.0;
+
+  const cv::Point2f measured = c - centre(box);
+  velocity += static_cast<float>(params.velocity_gain) * (measured - velocity);
+  box = box_at(c, box.size() * static_cast<float>(scale));
+  ++since_recent;
+  if (flow_failure == LostReason::Found && a.score >= params.trust_appearance && r.inliers >= 0.5 &&
+      since_recent >= params.template_interval) {
+    cut(cur, box, recent);
+    since_recent = 0;
+  }
+  prev = std::move(pyramid);
+  r.box = box;
+  r.velocity = velocity;
+  r.scale = scale;
+  return r;
+}
+
+// Median flow of the inliers, and the median ratio of their pairwise distances (pairs closer
+// than a fifth of the box would make noisy ratios) as `scale`.
+cv::Point2f LocalTracker::Impl::measure_motion(double& scale) {
+  work_x.clear();
+  work_y.clear();
+  for (int i : inliers) {
+    work_x.push_back(to[i].x - from[i].x);
+    work_y.push_back(to[i].y - from[i].y);
+  }
+  const cv::Point2f motion(median(work_x), median(work_y));
+  // Pixels that pass the check but move unlike the object (background inside the box, a shadow
+  // sliding over it) would bias the scale: keep those whose motion is the median one up to what
+  // a few percent of scale change allows at their distance from the centre.
+  const cv::Point2f c_prev = centre(box);
+  work_x.clear();
+  consistent.clear();
+  for (int i : inliers) {
+    const cv::Point2f dev = to[i] - from[i] - motion;
+    const cv::Point2f arm = from[i] - c_prev;
+    const float tol = 1.f + kScaleTolerance * std::sqrt(arm.dot(arm));
+    if (dev.dot(dev) <= tol * tol) consistent.push_back(i);
+  }
+  scale = 1.0;
+  if (consistent.size() < 2) return motion;
+  const float min_dist = std::max(2.f, 0.2f * std::min(box.width, box.height));
+  const float min_dist2 = min_dist * min_dist;
+  PairSampler pairs;
+  const std::size_t tries = 2 * consistent.size();
+  for (std::size_t k = 0; k < tries; ++k) {
+    const int a = consistent[pairs.next() % consistent.size()];
+    const int b = consistent[pairs.next() % consistent.size()];
+    const cv::Point2f d0 = from[a] - from[b];
+    const float n0 = d0.dot(d0);
+    if (n0 < min_dist2) continue;
+    const cv::Point2f d1 = to[a] - to[b];
+    work_x.push_back(std::sqrt(d1.dot(d1) / n0));
+  }
+  if (work_x.size() >= 8) scale = median(work_x);
+  return motion;
+}
+
+LocalTracker::LocalTracker(const LocalTrackerParams& params, const flow::Executor* executor)
+    : impl_(std::make_unique<Impl>()) {
+  params.validate();
+  impl_->params = params;
+  impl_->executor = executor;
+}
+
+LocalTracker::~LocalTracker() = default;
+LocalTracker::LocalTracker(LocalTracker&&) noexcept = default;
+LocalTracker& LocalTracker::operator=(LocalTracker&&) noexcept = default;
+
+const LocalTrackerParams& LocalTracker::params() const {
+  return impl_->params;
+}
+
+void LocalTracker::start(std::shared_ptr<const flow::Pyramid> pyramid, const cv::Rect2f& box) {
+  impl_->place(std::move(pyramid), box);
+  cut(*impl_->prev, box, impl_->templ);
+  impl_->recent.release();
+  impl_->since_recent = 0;
+}
+
+void LocalTracker::restart(std::shared_ptr<const flow::Pyramid> pyramid, const cv::Rect2f& box) {
+  if (impl_->templ.empty()) throw Error("local tracker: restart() before start()");
+  impl_->place(std::move(pyramid), box);
+}
+
+bool LocalTracker::started() const {
+  return impl_->prev != nullptr;
+}
+
+LocalResult LocalTracker::track(std::shared_ptr<const flow::Pyramid> pyramid) {
+  return impl_->track(std::move(pyramid));
+}
+
+cv::Rect2f LocalTracker::box() const {
+  return impl_->box;
+}
+
+cv::Point2f LocalTracker::velocity() const {
+  return impl_->velocity;
+}
+
+cv::Rect2f LocalTracker::predicted() const {
+  const Impl& s = *impl_;
+  return {s.box.x + s.velocity.x, s.box.y + s.velocity.y, s.box.width, s.box.height};
+}
+
+}  // namespace roiflow::stages

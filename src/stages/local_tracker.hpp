@@ -1,0 +1,130 @@
+// LocalTracker: the paper's local treatment — one object followed by dense LK on a local region.
+//
+//   using namespace roiflow;
+//   stages::LocalTracker local;                              // paper defaults: ROI 50, LK 10/3/3
+//   local.start(pyr0, {70, 51, 107, 87});                    // appearance captured from frame 0
+//   for (each next frame's pyramid pyr) {
+//     stages::LocalResult r = local.track(pyr);              // frame t-1 (kept) -> frame t
+//     if (r.lost) { /* global treatment, then local.restart(pyr, found_box) */ }
+//   }
+//
+// Per frame: the box of frame t-1 and the box the constant-velocity prediction puts in frame t
+// span the local region (at least roi x roi, centred on them). Dense LK runs forward over the
+// region, seeded with the predicted velocity, and backward around where the object went, seeded
+// with the reverse of its rough motion; the object's pixels (a grid over its box) whose
+// forward-backward error stays under `fb_threshold` give its motion (median flow), and those of
+// them that also move with that median (up to what a scale change allows) give its scale change
+// (median ratio of distances between pairs of them). That measurement is then corrected against
+// the target's appearance: the template captured by start() is matched (zero-mean NCC) at
+// 2 * scale_steps + 1 scales around the measured box, on the pyramid level where the object is
+// about `match_side` pixels across, and when the match is good the box moves part of the way
+// (`appearance_weight`) to it. That first appearance does not drift, so it pulls back the error
+// that chained flow accumulates, while flow keeps the box smooth where a lone match would jitter.
+// While the first appearance matches poorly (lighting, pose), a recent one, refreshed every
+// `template_interval` confidently tracked frames, stands in. Finally the velocity is corrected
+// by the measured displacement (an alpha-beta filter with alpha = 1: the reported box is the
+// measurement).
+//
+// The object is lost when too few of its pixels pass the forward-backward check or its box has
+// too little texture (unless the appearance, searched over twice the radius around the
+// prediction, still matches well: a sudden change of lighting breaks LK's brightness constancy,
+// not the object's look), when its appearance no longer matches, or when it leaves the local
+// region. A lost result carries the predicted box; the state moves to that prediction, so the
+// next call searches where the object should be (coasting) until restart() places it again.
+#pragma once
+
+#include <memory>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "flow/dense_lk.hpp"
+#include "flow/executor.hpp"
+#include "flow/pyramid.hpp"
+
+namespace roiflow::stages {
+
+struct LocalTrackerParams {
+  int roi = 50;  // least side of the local region in pixels (the paper's 50x50), 8..4096
+  flow::LkParams lk = flow::LkParams::paper();
+  bool whole_frame = false;       // LK over the whole frame (the paper's global-mode baseline)
+  int max_points = 512;           // object pixels sampled (a regular grid over the box), 16..1e6
+  int fb_levels = 1;              // pyramid levels of the backward LK (at most lk.levels), 1..6: it
+                                  // starts from the reverse of the measured motion, so only the
+                                  // residual is left to find and coarse levels would cost more
+                                  // (their margins) than they help
+  double fb_threshold = 1.0;      // forward-backward error in pixels above which a pixel is an
+                                  // outlier, > 0
+  double min_inliers = 0.25;      // lost below this share of the object's pixels passing the
+                                  // forward-backward check, [0, 1)
+  double min_texture = 1e-5;      // lost when the median smallest eigenvalue of the object's LK
+                                  // structure tensors (intensities in [0, 1]) is below this, >= 0
+  double min_appearance = 0.3;    // lost when the best NCC against the template is below this,
+                                  // [-1, 1)
+  double trust_appearance = 0.5;  // the appearance corrects the box only from this NCC on,
+                                  // [min_appearance, 1]
+  double appearance_weight = 0.5;  // how far the box moves to the appearance match, [0, 1]
+  double search = 0.15;            // appearance search radius, as a share of the box's shorter
+                                   // side (at least 3 pixels of the match level), (0, 2]
+  double scale_step = 0.03;        // relative step between the matched scales, (0, 0.5)
+  int scale_steps = 1;             // scales matched on each side of the measured one, 0..10
+  int match_side = 24;             // the shorter side the template is matched at (the finest
+                                   // pyramid level where the object is at least this size), 8..256
+  int template_interval = 10;      // frames between refreshes of the recent appearance (taken
+                                   // only from confidently tracked frames), >= 1
+  double velocity_gain = 0.5;      // share of the prediction error that corrects the velocity,
+                                   // [0, 1]
+  void validate() const;           // throws roiflow::Error naming the bad value
+};
+
+// Why a frame's result is lost (Found when it is not).
+enum class LostReason { Found, FewInliers, LowTexture, Appearance, LeftRegion };
+const char* to_string(LostReason reason);
+
+struct LocalResult {
+  cv::Rect2f box;        // the measured box in frame t; the prediction when lost
+  cv::Point2f velocity;  // pixels per frame, after correction
+  bool lost = false;
+  LostReason reason = LostReason::Found;
+  cv::Rect region;         // where forward LK ran (frame t-1 pixels)
+  cv::Mat region_flow;     // CV_32FC2 forward flow over `region`, owned by the result
+  double inliers = 0;      // share of the object's pixels that passed the forward-backward check
+  double texture = 0;      // median smallest eigenvalue over the object's pixels
+  double appearance = -1;  // best NCC against the template, -1 when it was not measured
+  double scale = 1;        // size change this frame (1 = none)
+};
+
+class LocalTracker {
+ public:
+  // `executor` splits LK into row stripes (nullptr = serial); it must outlive the tracker.
+  // Throws roiflow::Error on bad params.
+  explicit LocalTracker(const LocalTrackerParams& params = {},
+                        const flow::Executor* executor = nullptr);
+  ~LocalTracker();
+  LocalTracker(LocalTracker&&) noexcept;
+  LocalTracker& operator=(LocalTracker&&) noexcept;
+
+  const LocalTrackerParams& params() const;
+
+  // Starts on frame `pyramid` (built with params.lk.levels and lk.sigma) at `box`: captures the
+  // target's appearance there and sets the velocity to zero. Throws roiflow::Error when the box
+  // is not finite, has a side below 2 pixels or leaves fewer than 2x2 pixels inside the frame.
+  void start(std::shared_ptr<const flow::Pyramid> pyramid, const cv::Rect2f& box);
+  // Places the object again (after a re-detection) keeping the appearance captured by start().
+  void restart(std::shared_ptr<const flow::Pyramid> pyramid, const cv::Rect2f& box);
+  bool started() const;
+
+  // Follows the object from the previous frame to `pyramid` (same size as the previous one,
+  // else roiflow::Error). Throws roiflow::Error when not started.
+  LocalResult track(std::shared_ptr<const flow::Pyramid> pyramid);
+
+  cv::Rect2f box() const;        // the current box (measured or coasted)
+  cv::Point2f velocity() const;  // pixels per frame
+  cv::Rect2f predicted() const;  // where the constant-velocity prediction puts the next box
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace roiflow::stages

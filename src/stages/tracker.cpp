@@ -1,0 +1,342 @@
+#include "stages/tracker.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+#include "flow/error.hpp"
+
+namespace roiflow::stages {
+namespace {
+
+std::string num(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+std::string size_text(cv::Size s) {
+  return num(s.width) + " x " + num(s.height);
+}
+
+std::string box_text(const cv::Rect2f& b) {
+  return "(" + num(b.x) + ", " + num(b.y) + ", " + num(b.width) + " x " + num(b.height) + ")";
+}
+
+cv::Point2f centre(const cv::Rect2f& r) {
+  return {r.x + 0.5f * r.width, r.y + 0.5f * r.height};
+}
+
+// Median flow magnitude over a grid of the region's pixels that lie outside the object's box:
+// how fast the background moves, or -1 when the region holds too little of it to tell.
+double background_motion(const cv::Mat& flow, const cv::Rect& region, const cv::Rect2f& box) {
+  if (flow.empty()) return -1;
+  const int step = std::max(1, static_cast<int>(std::sqrt(region.area() / 256.0)));
+  std::vector<float> speeds;
+  for (int y = 0; y < region.height; y += step) {
+    const cv::Vec2f* row = flow.ptr<cv::Vec2f>(y);
+    for (int x = 0; x < region.width; x += step) {
+      if (box.contains(cv::Point2f(static_cast<float>(region.x + x) + 0.5f,
+                                   static_cast<float>(region.y + y) + 0.5f))) {
+        continue;
+      }
+      speeds.push_back(std::hypot(row[x][0], row[x][1]));
+    }
+  }
+  if (speeds.size() < 16) return -1;
+  const auto mid = speeds.begin() + static_cast<std::ptrdiff_t>(speeds.size() / 2);
+  std::nth_element(speeds.begin(), mid, speeds.end());
+  return *mid;
+}
+
+// A moving object found by background subtraction arrives with its recent past: the blob holds
+// the object and the "ghost" it left where the model had not yet learned the background (and
+// its motion blur). The paper's global treatment measures motion; so does this: LK over the
+// blob and its surroundings between the previous and this frame, the largest set of pixels that
+// really move, their box moved by their median flow. The motion boundary that LK's window
+// spreads by about half a window is taken off each side. Returns `box` unchanged when too few
+// pixels move.
+cv::Rect2f refine_by_motion(const flow::Pyramid& previous, const flow::Pyramid& current,
+                            const flow::LkParams& lk, const cv::Rect2f& box,
+                            const flow::Executor* executor) {
+  const cv::Size size = current.size();
+  const float pad = 0.1f * std::max(box.width, box.height) + 8.f;
+  const cv::Rect region = cv::Rect(cv::Point(static_cast<int>(std::floor(box.x - pad)),
+                                             static_cast<int>(std::floor(box.y - pad))),
+                                   cv::Point(static_cast<int>(std::ceil(box.br().x + pad)),
+                                             static_cast<int>(std::ceil(box.br().y + pad)))) &
+                          cv::Rect(cv::Point(), size);
+  if (region.width < 8 || region.height < 8) return box;
+  flow::FlowOptions options;
+  options.region = region;
+  options.executor = executor;
+  const flow::FlowResult r = flow::dense_flow(previous, current, lk, options);
+  std::vector<cv::Mat> uv;
+  cv::split(r.flow, uv);
+  cv::Mat magnitude;
+  cv::magnitude(uv[0], uv[1], magnitude);
+  std::vector<float> values(magnitude.begin<float>(), magnitude.end<float>());
+  const auto p90 = values.begin() + static_cast<std::ptrdiff_t>(values.size() * 9 / 10);
+  std::nth_element(values.begin(), p90, values.end());
+  const float threshold = std::max(0.5f, 0.7f * *p90);
+  cv::Mat moving = magnitude > threshold;
+  cv::morphologyEx(moving, moving, cv::MORPH_OPEN,
+                   cv::getStructuringElement(cv::MORPH_RECT, {3, 3}));
+  cv::Mat labels, stats, centroids;
+  const int n = cv::connectedComponentsWithStats(moving, labels, stats, centroids, 8, CV_32S);
+  int best = 0;
+  for (int i = 1; i < n; ++i) {
+    if (best == 0 || stats.at<int>(i, cv::CC_STAT_AREA) > stats.at<int>(best, cv::CC_STAT_AREA)) {
+      best = i;
+    }
+  }
+  if (best == 0 || stats.at<int>(best, cv::CC_STAT_AREA) < 16) return box;
+  std::vector<float> us, vs;
+  for (int y = 0; y < labels.rows; ++y) {
+    for (int x = 0; x < labels.cols; ++x) {
+      if (labels.at<int>(y, x) != best) continue;
+      const cv::Vec2f f = r.flow.at<cv::Vec2f>(y, x);
+      us.push_back(f[0]);
+      vs.push_back(f[1]);
+    }
+  }
+  const auto median = [](std::vector<float>& v) {
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+  };
+  const float du = median(us), dv = median(vs);
+  const float spread = 0.5f * static_cast<float>(lk.patch) - 1.f;
+  const float w = static_cast<float>(stats.at<int>(best, cv::CC_STAT_WIDTH)) - 2.f * spread;
+  const float h = static_cast<float>(stats.at<int>(best, cv::CC_STAT_HEIGHT)) - 2.f * spread;
+  if (w < 4.f || h < 4.f) return box;
+  const cv::Rect2f moved(
+      static_cast<float>(region.x + stats.at<int>(best, cv::CC_STAT_LEFT)) + spread + du,
+      static_cast<float>(region.y + stats.at<int>(best, cv::CC_STAT_TOP)) + spread + dv, w, h);
+  // The blob's edges are exact where the object leads (no ghost there) and LK's where it
+  // trails: their intersection keeps the better of both.
+  const cv::Rect2f both = moved & box;
+  return both.width >= 4.f && both.height >= 4.f ? both : moved;
+}
+
+}  // namespace
+
+void TrackerParams::validate() const {
+  if (roi < 8 || roi > 4096) throw Error("tracker: roi must be in 8..4096, got " + num(roi));
+  lk.validate();
+  if (init) {
+    const cv::Rect2f& b = *init;
+    if (!(std::isfinite(b.x) && std::isfinite(b.y) && std::isfinite(b.width) &&
+          std::isfinite(b.height) && b.width >= 2 && b.height >= 2)) {
+      throw Error("tracker: init box " + box_text(b) +
+                  " must be finite with sides of at least 2 pixels");
+    }
+  }
+  local.validate();
+  if (!(camera_motion > 0) || !std::isfinite(camera_motion)) {
+    throw Error("tracker: camera_motion must be > 0, got " + num(camera_motion));
+  }
+  if (observe_interval < 1 || observe_interval > 1000) {
+    throw Error("tracker: observe_interval must be in 1..1000, got " +
+                std::to_string(observe_interval));
+  }
+  detector.validate();
+}
+
+TrackRecord TrackerOutput::record() const {
+  TrackRecord r;
+  r.frame = index + 1;
+  r.box = box;
+  r.velocity = velocity;
+  r.mode = mode;
+  r.lost = lost || !has_target;  // no target yet: nothing was found on this frame
+  r.ms = ms;
+  return r;
+}
+
+struct Tracker::Impl {
+  TrackerParams params;
+  LocalTracker local;
+  GlobalDetector detector;
+  cv::Size size;  // of the first frame; empty before it
+  bool has_target = false;
+  bool lost = false;
+  bool camera_moves = false;
+  long long activations = 0;
+  long long observed_index = -1;  // the last frame given to the background model
+
+  static LocalTrackerParams local_params(const TrackerParams& p) {
+    p.validate();
+    LocalTrackerParams l = p.local;
+    l.roi = p.roi;
+    l.lk = p.lk;
+    l.whole_frame = p.mode == TrackMode::Global;
+    return l;
+  }
+
+  Impl(const TrackerParams& p, const flow::Executor* executor_)
+      : params(p), local(local_params(p), executor_), detector(p.detector), executor(executor_) {}
+
+  const flow::Executor* executor;
+  std::shared_ptr<const flow::Pyramid> previous;  // the last frame's pyramid
+
+  TrackerOutput process(const TrackerInput& frame);
+  void acquire(const TrackerInput& frame, TrackerOutput& out);
+  void follow(const TrackerInput& frame, TrackerOutput& out);
+
+  // The background model is only needed to find a target that was not given.
+  void observe(const TrackerInput& frame) {
+    if (params.init || observed_index == frame.index) return;
+    detector.observe(frame.image.empty() ? frame.gray : frame.image);
+    observed_index = frame.index;
+  }
+};
+
+void Tracker::Impl::acquire(const TrackerInput& frame, TrackerOutput& out) {
+  const cv::Mat& image = frame.image.empty() ? frame.gray : frame.image;
+  if (params.init) {
+    const cv::Rect2f& b = *params.init;
+    const cv::Rect2f inside =
+        b & cv::Rect2f(0.f, 0.f, static_cast<float>(size.width), static_cast<float>(size.height));
+    if (inside.width < 2 || inside.height < 2) {
+      throw Error("tracker: init box " + box_text(b) + " lies outside the " + size_text(size) +
+                  " frame");
+    }
+    detector.set_target(image, b);
+    local.start(frame.pyramid, b);
+    if (params.mode == TrackMode::Global) ++activations;
+    out.mode =
+        params.mode == TrackMode::Global ? TrackRecord::Mode::Global : TrackRecord::Mode::Local;
+    out.box = b;
+  } else {
+    // Without a given target the global treatment runs on every frame until it finds one.
+    ++activations;
+    const std::vector<Detection> objects = detector.moving_objects();
+    out.mode = TrackRecord::Mode::Global;
+    if (objects.empty()) return;
+    const cv::Rect2f box = previous ? refine_by_motion(*previous, *frame.pyramid, params.lk,
+                                                       objects.front().box, executor)
+                                    : objects.front().box;
+    detector.set_target(image, box);
+    local.start(frame.pyramid, box);
+    out.box = box;
+  }
+  has_target = true;
+  out.has_target = true;
+}
+
+void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out) {
+  const cv::Rect2f before = local.box();  // where the object was on the grid of region_flow
+  const LocalResult r = local.track(frame.pyramid);
+  out.has_target = true;
+  out.region = r.region;
+  out.region_flow = r.region_flow;
+  const bool global_mode = params.mode == TrackMode::Global;
+  if (global_mode) ++activations;
+  out.mode = global_mode ? TrackRecord::Mode::Global : TrackRecord::Mode::Local;
+  if (!r.region_flow.empty()) {
+    const double bg = background_motion(r.region_flow, r.region, before);
+    if (bg >= 0) camera_moves = bg > params.camera_motion;
+  }
+  if (!r.lost) {
+    lost = false;
+    out.box = r.box;
+    out.velocity = r.velocity;
+    detector.set_target_size(r.box.size());
+    return;
+  }
+  // Lost: the global treatment searches the whole frame; until it succeeds the box coasts.
+  if (!global_mode) ++activations;
+  out.mode = TrackRecord::Mode::Global;
+  const cv::Mat& image = frame.image.empty() ? frame.gray : frame.image;
+  observe(frame);
+  const bool by_appearance = params.init.has_value() || camera_moves;
+  const std::optional<Detection> found =
+      detector.find_target(image, frame.gray, centre(r.box), by_appearance);
+  if (found) {
+    local.restart(frame.pyramid, found->box);
+    lost = false;
+    out.box = found->box;
+    return;
+  }
+  lost = true;
+  out.lost = true;
+  out.box = r.box;
+  out.velocity = r.velocity;
+}
+
+TrackerOutput Tracker::Impl::process(const TrackerInput& frame) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (frame.gray.empty() || frame.gray.type() != CV_8UC1) {
+    throw Error(
+        "tracker: frame " + num(static_cast<double>(frame.index)) +
+        ": gray must be 8-bit single-channel, got " +
+        (frame.gray.empty() ? std::string("an empty image") : cv::typeToString(frame.gray.type())));
+  }
+  if (size.empty()) size = frame.gray.size();
+  if (frame.gray.size() != size) {
+    throw Error("tracker: frame " + num(static_cast<double>(frame.index)) + " is " +
+                size_text(frame.gray.size()) + ", the first frame was " + size_text(size));
+  }
+  if (!frame.image.empty() && frame.image.size() != size) {
+    throw Error("tracker: frame " + num(static_cast<double>(frame.index)) + ": image is " +
+                size_text(frame.image.size()) + " but gray is " + size_text(size));
+  }
+  if (!frame.pyramid || frame.pyramid->size() != size ||
+      frame.pyramid->num_levels() < flow::effective_levels(size, params.lk.levels)) {
+    throw Error("tracker: frame " + num(static_cast<double>(frame.index)) +
+                ": the pyramid must be built from gray with pyramid_levels() levels");
+  }
+  if (!has_target || lost || frame.index % params.observe_interval == 0) observe(frame);
+
+  TrackerOutput out;
+  out.index = frame.index;
+  if (has_target) {
+    follow(frame, out);
+  } else {
+    acquire(frame, out);
+  }
+  previous = frame.pyramid;
+  out.global_activations = activations;
+  out.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+Tracker::Tracker(const TrackerParams& params, const flow::Executor* executor)
+    : impl_(std::make_unique<Impl>(params, executor)) {}
+
+Tracker::~Tracker() = default;
+Tracker::Tracker(Tracker&&) noexcept = default;
+Tracker& Tracker::operator=(Tracker&&) noexcept = default;
+
+int Tracker::pyramid_levels() const {
+  return impl_->params.lk.levels;
+}
+
+double Tracker::pyramid_sigma() const {
+  return impl_->params.lk.sigma;
+}
+
+TrackerOutput Tracker::process(const TrackerInput& frame) {
+  return impl_->process(frame);
+}
+
+long long Tracker::global_activations() const {
+  return impl_->activations;
+}
+
+const char* to_string(TrackMode mode) {
+  return mode == TrackMode::Global ? "global" : "local";
+}
+
+TrackMode track_mode_from_string(std::string_view name) {
+  if (name == "local") return TrackMode::Local;
+  if (name == "global") return TrackMode::Global;
+  throw Error("unknown track mode '" + std::string(name) + "' (expected local or global)");
+}
+
+}  // namespace roiflow::stages

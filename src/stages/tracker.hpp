@@ -1,0 +1,122 @@
+// Tracker: the paper's system for one object — local treatment with a global fallback.
+//
+//   using namespace roiflow;
+//   stages::TrackerParams params;                    // paper defaults: ROI 50, LK 10x10/3/3
+//   params.init = cv::Rect2f(70, 51, 107, 87);       // OTB protocol; leave empty to detect
+//   stages::Tracker tracker(params);
+//   while (auto f = source.next()) {
+//     auto pyr = std::make_shared<flow::Pyramid>(flow::build_pyramid(
+//         f->gray, tracker.pyramid_levels(), tracker.pyramid_sigma()));
+//     stages::TrackerOutput out = tracker.process({f->index, f->image, f->gray, pyr});
+//     if (out.has_target) log.write(to_record(out));
+//   }
+//
+// Per frame, in order:
+//  - no target yet: the global treatment (GlobalDetector) looks for a moving object (fixed
+//    camera) and, once found, the target's box, appearance and signature are captured; with
+//    `init` the target is known from the first frame.
+//  - local mode: dense LK on the pyramids of frames t-1 and t, only inside the local region
+//    (at least roi x roi, larger for a large object) placed where the prediction puts the object;
+//    robust object motion (median flow of the object's pixels that pass a forward-backward
+//    check), scale change from point spreads, a correction of the measurement against the
+//    target's appearance, and a constant-velocity prediction corrected by the measurement
+//    (paper Fig. 3) that places the region for the next frame.
+//  - the decision: the object stays found while enough of its pixels pass the
+//    forward-backward check, it has texture, its appearance still matches and it stays inside
+//    its region; otherwise it is lost and the global treatment runs (counted in
+//    global_activations) until it is found again; between, the box coasts on the prediction
+//    and is reported lost.
+//  - global mode (the paper's baseline): the same estimator, but LK runs over the whole frame
+//    every frame and every frame counts as a global activation.
+#pragma once
+
+#include <memory>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string_view>
+
+#include "flow/dense_lk.hpp"
+#include "flow/executor.hpp"
+#include "flow/pyramid.hpp"
+#include "stages/global_detector.hpp"
+#include "stages/local_tracker.hpp"
+#include "stages/track_log.hpp"
+
+namespace roiflow::stages {
+
+enum class TrackMode { Local, Global };
+
+struct TrackerParams {
+  TrackMode mode = TrackMode::Local;
+  int roi = 50;  // side of the local region in pixels (the paper's 50x50), 8..4096; the region
+                 // grows beyond it to hold a larger object and its motion
+  flow::LkParams lk = flow::LkParams::paper();
+  std::optional<cv::Rect2f> init;  // the target's box in the first frame (OTB protocol)
+  // The rest of the local treatment (forward-backward check, appearance correction, thresholds
+  // of the decision); its roi, lk and whole_frame are taken from roi, lk and mode above.
+  LocalTrackerParams local;
+  // Background flow (median over the local region outside the object, pixels per frame) above
+  // which the camera is taken to move: the background model then sees everything move, so a lost
+  // target is searched by appearance, as when it came from `init`. > 0.
+  double camera_motion = 1.0;
+  // Without `init`, the background model that finds the object again is refreshed every
+  // `observe_interval` frames while the local treatment holds the target (every frame while the
+  // global treatment searches, and on the frame the target is lost). It only has to stay
+  // current enough for a later re-detection; refreshing it every frame would cost more than
+  // the local treatment itself. 1..1000.
+  int observe_interval = 4;
+  GlobalDetectorParams detector;
+  void validate() const;  // throws roiflow::Error naming the bad value
+};
+
+// One frame as the pipeline hands it over. The pyramid is built from `gray` with
+// pyramid_levels() and pyramid_sigma(); the tracker keeps the shared_ptr of the previous frame.
+struct TrackerInput {
+  long long index = 0;
+  cv::Mat image;  // as decoded, 8-bit BGR or gray
+  cv::Mat gray;   // 8-bit gray
+  std::shared_ptr<const flow::Pyramid> pyramid;
+};
+
+struct TrackerOutput {
+  long long index = 0;
+  bool has_target = false;  // false until the target is known (given or detected)
+  cv::Rect2f box;           // the target's box in this frame (valid when has_target)
+  cv::Point2f velocity;     // pixels per frame, corrected estimate
+  TrackRecord::Mode mode = TrackRecord::Mode::Global;  // the treatment that produced the box
+  bool lost = false;    // the target was not found in this frame (box = prediction)
+  cv::Rect region;      // where LK ran for this frame (empty when it did not run)
+  cv::Mat region_flow;  // CV_32FC2 flow over `region` (t-1 -> t), for annotation; may be empty
+  double ms = 0;        // time process() took
+  long long global_activations = 0;  // running count, this frame included
+
+  TrackRecord record() const;  // 1-based frame = index + 1, as the track log wants
+};
+
+class Tracker {
+ public:
+  // `executor` splits LK over row tiles of the region (nullptr = serial); it must outlive the
+  // tracker. Throws roiflow::Error on bad params.
+  explicit Tracker(const TrackerParams& params, const flow::Executor* executor = nullptr);
+  ~Tracker();
+  Tracker(Tracker&&) noexcept;
+  Tracker& operator=(Tracker&&) noexcept;
+
+  int pyramid_levels() const;
+  double pyramid_sigma() const;
+
+  // Frames must come in order, one size for the run. Throws roiflow::Error on a frame whose size
+  // differs from the first one's or an `init` box outside the first frame.
+  TrackerOutput process(const TrackerInput& frame);
+
+  long long global_activations() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+const char* to_string(TrackMode mode);
+TrackMode track_mode_from_string(std::string_view name);  // "local" | "global"
+
+}  // namespace roiflow::stages
