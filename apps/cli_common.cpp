@@ -2,7 +2,6 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <opencv2/imgcodecs.hpp>
 
 #include "flow/pyramid.hpp"
@@ -106,51 +105,6 @@ void check_image_output(const std::string& path, const std::string& option) {
     throw UsageError(option + ": cannot write an image named '" + path +
                      "' (use an extension such as .png)");
   }
-}
-
-namespace {
-
-// The partial file keeps the extension, from which cv::imwrite picks the format.
-fs::path partial_path(const fs::path& path) {
-  fs::path partial = path;
-  partial.replace_filename("." + path.stem().string() + ".partial" + path.extension().string());
-  return partial;
-}
-
-// `write(partial)` writes next to the target, which is then renamed over it: a reader never
-// sees half a file, and a failed write leaves nothing behind.
-// `what` names the kind of file in the error message ("image ", or empty).
-template <class Write>
-void write_atomically(const std::string& path, const std::string& what, Write&& write) {
-  const fs::path partial = partial_path(path);
-  bool written = false;
-  try {
-    written = write(partial.string());
-  } catch (const cv::Exception&) {
-    written = false;
-  }
-  std::error_code ec;
-  if (written) fs::rename(partial, path, ec);
-  if (!written || ec) {
-    fs::remove(partial, ec);
-    throw Error("cannot write " + what + "'" + path + "'");
-  }
-}
-
-}  // namespace
-
-void write_image(const std::string& path, const cv::Mat& image) {
-  write_atomically(path, "image ",
-                   [&](const std::string& partial) { return cv::imwrite(partial, image); });
-}
-
-void write_text(const std::string& path, const std::string& text) {
-  write_atomically(path, "", [&](const std::string& partial) {
-    std::ofstream out(partial, std::ios::binary);
-    out << text;
-    out.close();
-    return static_cast<bool>(out);
-  });
 }
 
 }  // namespace roiflow::cli

@@ -41,9 +41,7 @@ std::string errors_line(const flow::FlowErrors& e);
 void check_output_path(const std::string& path, const std::string& option);
 void check_image_output(const std::string& path, const std::string& option);
 
-// Written next to the target and renamed over it: a reader never sees half a file, and a
-// failed write leaves nothing behind.
-void write_image(const std::string& path, const cv::Mat& image);
-void write_text(const std::string& path, const std::string& text);
+// roiflow track, dense and demo (video_commands.cpp); a run's exit code goes to `exit_code`.
+void add_video_commands(CLI::App& app, int& exit_code);
 
 }  // namespace roiflow::cli

@@ -31,6 +31,7 @@
 #include "flow/pyramid.hpp"
 #include "flow/synthetic.hpp"
 #include "pipeline/tbb_executor.hpp"
+#include "stages/atomic_write.hpp"
 #include "stages/flow_eval.hpp"
 #include "stages/otb_score.hpp"
 #include "stages/track_log.hpp"
@@ -125,11 +126,11 @@ void run_flow(const FlowCommand& cmd) {
   std::string written = cmd.output;
   flow::write_flo(cmd.output, result.flow);
   if (!cmd.color.empty()) {
-    write_image(cmd.color, flow::flow_to_color(result.flow));
+    stages::write_image_atomically(cmd.color, flow::flow_to_color(result.flow));
     written += ", " + cmd.color;
   }
   if (!cmd.legend.empty()) {
-    write_image(cmd.legend, flow::color_wheel_legend());
+    stages::write_image_atomically(cmd.legend, flow::color_wheel_legend());
     written += ", " + cmd.legend;
   }
 
@@ -218,7 +219,7 @@ void run_eval(const EvalCommand& cmd) {
   if (cmd.output.empty()) {
     std::cout << text;
   } else {
-    write_text(cmd.output, text);
+    stages::write_text_atomically(cmd.output, text);
     std::cout << "evaluated " << rows.size() << " pairs, wrote " << cmd.output << "\n";
   }
 }
@@ -340,6 +341,8 @@ int main(int argc, char** argv) {
   add_flow_command(app, flow_cmd);
   add_eval_command(app, eval_cmd);
   add_score_command(app, score_cmd);
+  int exit_code = 0;
+  add_video_commands(app, exit_code);
 
   try {
     app.parse(argc, argv);
@@ -356,5 +359,5 @@ int main(int argc, char** argv) {
   } catch (...) {
     return report("unexpected failure", 1);
   }
-  return 0;
+  return exit_code;
 }

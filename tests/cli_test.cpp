@@ -7,14 +7,18 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "flow/flo_io.hpp"
 #include "flow/synthetic.hpp"
+#include "flow/tracking_scene.hpp"
+#include "stages/track_log.hpp"
 #include "test_util.hpp"
 
 namespace {
@@ -344,6 +348,142 @@ TEST_F(CliScoreTest, BadInputsFailWithOneLine) {
     expect_one_line_error(r, c.exit_code);
     EXPECT_NE(r.err.find(c.expected), std::string::npos) << r.err;
   }
+}
+
+// ---------------------------------------------------------------------------------------------
+// roiflow track, dense, demo
+
+class CliVideoTest : public CliTest {
+ protected:
+  // A short synthetic fixed-camera video (the demo's scene, 160x120) as MJPG .avi, and its
+  // ground-truth boxes as an OTB file.
+  void SetUp() override {
+    CliTest::SetUp();
+    flow::TrackingSceneParams params;
+    params.size = {160, 120};
+    params.frames = 30;
+    params.object = {28.f, 18.f};
+    params.jump = 10.0;
+    scene_ = std::make_unique<flow::TrackingScene>(params);
+    cv::VideoWriter writer(path("scene.avi"), cv::CAP_FFMPEG,
+                           cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 25.0, params.size);
+    ASSERT_TRUE(writer.isOpened());
+    std::ofstream truth(path("truth.txt"));
+    for (int i = 0; i < scene_->frames(); ++i) {
+      writer.write(scene_->render(i));
+      const cv::Rect2f b = scene_->box(i);
+      truth << b.x << "," << b.y << "," << b.width << "," << b.height << "\n";
+    }
+  }
+  std::string init_box() const {
+    const cv::Rect2f b = scene_->box(0);
+    return std::to_string(b.x) + "," + std::to_string(b.y) + "," + std::to_string(b.width) + "," +
+           std::to_string(b.height);
+  }
+  std::unique_ptr<flow::TrackingScene> scene_;
+};
+
+TEST_F(CliVideoTest, TrackWritesLogSummaryAndVideoThatScoreReads) {
+  const CliResult r = run({"track", path("scene.avi"), "--init", init_box(), "--log",
+                           path("track.csv"), "--summary", path("summary.json"), "--out",
+                           path("annotated.avi"), "--threads", "2", "--no-progress"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  const std::vector<stages::TrackRecord> log = stages::read_track_csv(path("track.csv"));
+  ASSERT_EQ(log.size(), 30u);
+  for (std::size_t i = 0; i < log.size(); ++i)
+    EXPECT_EQ(log[i].frame, static_cast<long long>(i) + 1);
+  const auto summary = nlohmann::json::parse(read_text(path("summary.json")));
+  EXPECT_EQ(summary.at("frames").get<long long>(), 30);
+  EXPECT_EQ(summary.at("mode").get<std::string>(), "local");
+  EXPECT_GT(summary.at("fps").get<double>(), 0.0);
+  EXPECT_GT(summary.at("tracker_fps").get<double>(), 0.0);
+  EXPECT_GE(summary.at("global_activations").get<long long>(), 0);
+  cv::VideoCapture video(path("annotated.avi"), cv::CAP_FFMPEG);
+  ASSERT_TRUE(video.isOpened());
+  EXPECT_EQ(static_cast<int>(video.get(cv::CAP_PROP_FRAME_COUNT)), 30);
+
+  const CliResult s = run({"score", path("track.csv"), path("truth.txt"), "--format", "json"});
+  ASSERT_EQ(s.exit_code, 0) << s.err;
+  const auto score = nlohmann::json::parse(s.out);
+  EXPECT_GT(score.at("precision20").get<double>(), 0.9);
+  EXPECT_GT(score.at("auc").get<double>(), 0.5);
+}
+
+TEST_F(CliVideoTest, GlobalModeActivatesTheGlobalTreatmentEveryFrame) {
+  const CliResult r = run({"track", path("scene.avi"), "--init", init_box(), "--mode", "global",
+                           "--summary", path("global.json"), "--no-progress"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const CliResult l = run({"track", path("scene.avi"), "--init", init_box(), "--summary",
+                           path("local.json"), "--no-progress"});
+  ASSERT_EQ(l.exit_code, 0) << l.err;
+  const auto global = nlohmann::json::parse(read_text(path("global.json")));
+  const auto local = nlohmann::json::parse(read_text(path("local.json")));
+  EXPECT_EQ(global.at("mode").get<std::string>(), "global");
+  EXPECT_EQ(global.at("global_activations").get<long long>(), 30);
+  EXPECT_LT(local.at("global_activations").get<long long>(), 30);
+}
+
+TEST_F(CliVideoTest, DenseWritesOneColourFramePerPair) {
+  const CliResult r = run({"dense", path("scene.avi"), "--out", path("flow_frames"), "--max-frames",
+                           "6", "--summary", path("dense.json"), "--no-progress"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  int pngs = 0;
+  for (const auto& entry : fs::directory_iterator(path("flow_frames"))) {
+    EXPECT_EQ(entry.path().extension(), ".png");
+    ++pngs;
+  }
+  EXPECT_EQ(pngs, 5);
+  const auto summary = nlohmann::json::parse(read_text(path("dense.json")));
+  EXPECT_EQ(summary.at("pairs").get<long long>(), 5);
+  EXPECT_EQ(summary.at("mode").get<std::string>(), "dense");
+}
+
+TEST_F(CliVideoTest, DemoTracksTheSceneAndPrintsItsError) {
+  const CliResult r = run({"demo", "--dir", path("demo"), "--frames", "60", "--no-progress"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("success AUC"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("mean centre error"), std::string::npos) << r.out;
+  for (const char* file : {"demo.mp4", "track.csv", "summary.json", "groundtruth.txt"}) {
+    EXPECT_TRUE(fs::exists(path("demo") + "/" + file)) << file;
+  }
+  EXPECT_EQ(stages::read_track_csv(path("demo/track.csv")).size(), 60u);
+  const auto summary = nlohmann::json::parse(read_text(path("demo/summary.json")));
+  EXPECT_GT(summary.at("score").at("precision20").get<double>(), 0.8);
+  EXPECT_GE(summary.at("global_activations").get<long long>(), 1);
+}
+
+TEST_F(CliVideoTest, BadVideoCommandLinesFailWithOneLine) {
+  std::ofstream(path("garbage.avi"), std::ios::binary) << "not a video at all";
+  struct Case {
+    std::vector<std::string> args;
+    int exit_code;
+    std::string expected;  // in the error line
+  };
+  const std::vector<Case> cases = {
+      {{"track", path("missing.avi")}, 1, path("missing.avi")},
+      {{"track", path("garbage.avi")}, 1, path("garbage.avi")},
+      {{"track", path("scene.avi"), "--init", "1,2,3"}, 2, "--init"},
+      {{"track", path("scene.avi"), "--init", "1,2,-3,4"}, 2, "--init"},
+      {{"track", path("scene.avi"), "--init", "500,500,10,10"}, 2, "outside"},
+      {{"track", path("scene.avi"), "--log", path("track.txt")}, 2, ".csv or .json"},
+      {{"track", path("scene.avi"), "--roi", "0"}, 2, "--roi"},
+      {{"track", path("scene.avi"), "--mode", "both"}, 2, "--mode"},
+      {{"track", path("scene.avi"), "--log", path("no/such/dir/t.csv")}, 1, "no/such/dir"},
+      {{"dense", path("scene.avi")}, 2, "--out"},
+      {{"dense", path("scene.avi"), "--out", path("x.avi"), "--patch", "2"}, 2, "--patch"},
+      {{"demo", "--frames", "1"}, 2, "--frames"},
+  };
+  for (const Case& c : cases) {
+    std::string shown;
+    for (const std::string& arg : c.args)
+      shown += " " + arg;
+    SCOPED_TRACE("roiflow" + shown);
+    const CliResult r = run(c.args);
+    expect_one_line_error(r, c.exit_code);
+    EXPECT_NE(r.err.find(c.expected), std::string::npos) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(path("track.txt")));
 }
 
 }  // namespace

@@ -1,0 +1,158 @@
+// The whole pipeline on video files: decode-only ceiling, tracking in local and global mode,
+// dense mode, each at 1 and 2 threads, in one binary so that ratios come from one run.
+//
+//   build/release/bench/pipeline_bench                       # the synthetic 640x480 video
+//   ROIFLOW_VIDEOS=../shared/data/video build/release/bench/pipeline_bench
+//
+//   BM_Decode/<video>                       VideoSource alone: the ceiling of any pipeline
+//   BM_Track/<video>/<local|global>/threads:<n>   run_tracking, no sinks; the target is found
+//                                           by the global treatment (no --init)
+//   BM_Dense/<video>/threads:<n>            run_dense (paper preset), no sinks
+//
+// <video> is synthetic640x480 (300 frames of the demo's TrackingScene, written once as MPEG-4
+// to the temp dir) and, with ROIFLOW_VIDEOS=DIR, every .avi/.mp4/.mkv in DIR. One iteration
+// processes the whole file. Counters: fps, frames per wall-clock second of the whole run
+// (decode included); tracker_fps, frames per second of the tracker's own busy time (pyramid +
+// LK + decision: decode excluded), global_activations.
+#include <benchmark/benchmark.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+#include <string>
+#include <vector>
+
+#include "flow/tracking_scene.hpp"
+#include "pipeline/frame_graph.hpp"
+#include "pipeline/tbb_executor.hpp"
+#include "stages/run_stats.hpp"
+#include "stages/tracker.hpp"
+#include "stages/video_sink.hpp"
+#include "stages/video_source.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace roiflow;
+
+constexpr int kThreadCounts[] = {1, 2};
+
+std::string synthetic_video() {
+  const fs::path path = fs::temp_directory_path() / "roiflow_bench_synthetic640x480.mp4";
+  if (!fs::exists(path)) {
+    flow::TrackingSceneParams params;
+    params.frames = 300;
+    const flow::TrackingScene scene(params);
+    stages::VideoSink sink(path.string(), 25.0, scene.size());
+    for (int i = 0; i < scene.frames(); ++i)
+      sink.write(scene.render(i));
+    sink.close();
+  }
+  return path.string();
+}
+
+double ms_total(const nlohmann::ordered_json& stats, const char* stage) {
+  const auto& stages = stats.at("stages");
+  return stages.contains(stage) ? stages.at(stage).at("ms_total").get<double>() : 0.0;
+}
+
+void bm_decode(benchmark::State& state, const std::string& path) {
+  long long frames = 0;
+  for (auto _ : state) {
+    stages::VideoSource source(path);
+    while (auto f = source.next()) {
+      benchmark::DoNotOptimize(f->gray.data);
+      ++frames;
+    }
+  }
+  state.counters["fps"] =
+      benchmark::Counter(static_cast<double>(frames), benchmark::Counter::kIsRate);
+}
+
+void bm_track(benchmark::State& state, const std::string& path, stages::TrackMode mode,
+              int threads) {
+  long long frames = 0;
+  double tracker_ms = 0;
+  long long activations = 0;
+  for (auto _ : state) {
+    stages::VideoSource source(path);
+    pipeline::TbbExecutor tiles;
+    stages::TrackerParams params;
+    params.mode = mode;
+    stages::Tracker tracker(params, &tiles);
+    stages::RunStats stats;
+    pipeline::GraphOptions options;
+    options.threads = threads;
+    options.stats = &stats;
+    const pipeline::RunReport report =
+        pipeline::run_tracking([&] { return source.next(); }, tracker, {}, options);
+    frames += report.frames;
+    const auto json = stats.to_json(report.wall_s);
+    tracker_ms += ms_total(json, "pyramid") + ms_total(json, "track");
+    activations = tracker.global_activations();
+  }
+  state.counters["fps"] =
+      benchmark::Counter(static_cast<double>(frames), benchmark::Counter::kIsRate);
+  state.counters["tracker_fps"] = tracker_ms > 0 ? frames / (tracker_ms / 1000.0) : 0.0;
+  state.counters["global_activations"] = static_cast<double>(activations);
+}
+
+void bm_dense(benchmark::State& state, const std::string& path, int threads) {
+  long long pairs = 0;
+  for (auto _ : state) {
+    stages::VideoSource source(path);
+    pipeline::GraphOptions options;
+    options.threads = threads;
+    const pipeline::RunReport report =
+        pipeline::run_dense([&] { return source.next(); }, flow::LkParams::paper(), {}, options);
+    pairs += report.frames - 1;
+  }
+  state.counters["fps"] =
+      benchmark::Counter(static_cast<double>(pairs), benchmark::Counter::kIsRate);
+}
+
+void register_video(const std::string& name, const std::string& path) {
+  benchmark::RegisterBenchmark(("BM_Decode/" + name).c_str(), bm_decode, path)
+      ->Unit(benchmark::kMillisecond)
+      ->UseRealTime()
+      ->Iterations(1);
+  for (int threads : kThreadCounts) {
+    for (stages::TrackMode mode : {stages::TrackMode::Local, stages::TrackMode::Global}) {
+      const std::string bm = "BM_Track/" + name + "/" + stages::to_string(mode) +
+                             "/threads:" + std::to_string(threads);
+      benchmark::RegisterBenchmark(bm.c_str(), bm_track, path, mode, threads)
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime()
+          ->Iterations(1);
+    }
+  }
+  for (int threads : kThreadCounts) {
+    const std::string bm = "BM_Dense/" + name + "/threads:" + std::to_string(threads);
+    benchmark::RegisterBenchmark(bm.c_str(), bm_dense, path, threads)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime()
+        ->Iterations(1);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  register_video("synthetic640x480", synthetic_video());
+  if (const char* dir = std::getenv("ROIFLOW_VIDEOS")) {
+    std::vector<fs::path> videos;
+    for (const auto& entry : fs::directory_iterator(dir)) {
+      const std::string ext = entry.path().extension().string();
+      if (ext == ".avi" || ext == ".mp4" || ext == ".mkv") videos.push_back(entry.path());
+    }
+    std::sort(videos.begin(), videos.end());
+    for (const fs::path& v : videos)
+      register_video(v.stem().string(), v.string());
+  }
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -1,0 +1,398 @@
+#include "pipeline/frame_graph.hpp"
+
+#include <oneapi/tbb/flow_graph.h>
+#include <oneapi/tbb/info.h>
+
+#include <chrono>
+#include <opencv2/imgproc.hpp>
+#include <string>
+#include <tuple>
+#include <unordered_map>
+
+#include "flow/error.hpp"
+#include "pipeline/tbb_executor.hpp"
+
+namespace roiflow::pipeline {
+namespace {
+
+namespace tf = oneapi::tbb::flow;
+using Clock = std::chrono::steady_clock;
+
+// ThreadSanitizer cannot see the synchronisation inside oneTBB when the library itself is not
+// instrumented (Debian's is not), so every message hand-over would look like a race. Each node
+// body therefore acquires a per-graph token when it starts and releases it when it ends: bodies
+// that ran one after the other are ordered, as TBB orders them; bodies that really overlapped
+// stay unordered, so a race between them is still reported.
+#if defined(__SANITIZE_THREAD__)
+extern "C" void __tsan_acquire(void* addr);
+extern "C" void __tsan_release(void* addr);
+class BodyScope {
+ public:
+  explicit BodyScope(void* token) : token_(token) { __tsan_acquire(token_); }
+  ~BodyScope() { __tsan_release(token_); }
+  BodyScope(const BodyScope&) = delete;
+  BodyScope& operator=(const BodyScope&) = delete;
+
+ private:
+  void* token_;
+};
+#else
+class BodyScope {
+ public:
+  explicit BodyScope(void*) {}
+};
+#endif
+
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// A decoded frame on its way through the pyramid levels.
+struct FrameMsg {
+  long long seq = 0;
+  std::shared_ptr<const stages::Frame> frame;
+  std::shared_ptr<flow::Pyramid> pyramid;  // filled level by level, then only read
+};
+
+// A frame or pair done with by `votes` consumers; retired when all of them have voted.
+struct RetireMsg {
+  long long seq = 0;
+  int votes = 1;
+};
+
+// What every graph shares: options, counters, timing.
+class Run {
+ public:
+  explicit Run(const GraphOptions& options) : options_(options) {}
+
+  void enter(Stage stage, long long seq) const {
+    if (options_.on_stage) options_.on_stage(stage, seq);
+  }
+  void time(const char* stage, Clock::time_point start) const {
+    if (options_.stats != nullptr) options_.stats->add(stage, ms_since(start));
+  }
+  void time(const std::string& stage, Clock::time_point start) const {
+    if (options_.stats != nullptr) options_.stats->add(stage, ms_since(start));
+  }
+  bool cancel_requested() const {
+    return options_.cancel != nullptr && options_.cancel->load(std::memory_order_relaxed);
+  }
+
+  // A frame passed the limiter.
+  void admitted() {
+    const long long now = alive_.fetch_add(1) + 1;
+    long long seen = max_alive_.load();
+    while (now > seen && !max_alive_.compare_exchange_weak(seen, now)) {
+    }
+  }
+  // Called by the (serial) retire node: true when the frame is done and the limiter may let
+  // another one in.
+  bool vote(const RetireMsg& msg, int needed) {
+    int& count = votes_[msg.seq];
+    count += msg.votes;
+    if (count < needed) return false;
+    votes_.erase(msg.seq);
+    alive_.fetch_sub(1);
+    ++retired_;
+    if (options_.stats != nullptr) options_.stats->add_frames(1);
+    return true;
+  }
+
+  RunReport report(double wall_s, bool cancelled) const {
+    RunReport r;
+    r.frames = retired_;
+    r.max_in_flight = max_alive_.load();
+    r.cancelled = cancelled;
+    r.wall_s = wall_s;
+    return r;
+  }
+
+  const GraphOptions& options() const { return options_; }
+  void* token() { return &token_; }
+
+ private:
+  const GraphOptions& options_;
+  std::atomic<long long> alive_{0};
+  std::atomic<long long> max_alive_{0};
+  std::unordered_map<long long, int> votes_;  // touched by the serial retire node only
+  long long retired_ = 0;
+  char token_ = 0;  // see BodyScope
+};
+
+int thread_count(const GraphOptions& options) {
+  if (options.threads < 0 || options.threads > kMaxThreads) {
+    throw Error("threads must be in 0.." + std::to_string(kMaxThreads) + " (0 = all), got " +
+                std::to_string(options.threads));
+  }
+  return options.threads == 0 ? oneapi::tbb::info::default_concurrency() : options.threads;
+}
+
+int in_flight_limit(const GraphOptions& options, int threads) {
+  if (options.max_in_flight < 0) {
+    throw Error("frames in flight must be >= 1 (0 = automatic), got " +
+                std::to_string(options.max_in_flight));
+  }
+  return options.max_in_flight == 0 ? 2 * threads + 2 : options.max_in_flight;
+}
+
+// source -> limiter -> level 0 -> level 1 -> ... -> sequencer: the part both modes share.
+class FrontEnd {
+ public:
+  FrontEnd(tf::graph& g, Run& run, const FrameSource& source, int limit, int levels, double sigma)
+      : run_(run),
+        source_(source),
+        input_(g, [this](oneapi::tbb::flow_control& fc) { return next(fc); }),
+        limiter_(g, static_cast<std::size_t>(limit)),
+        sequencer_(g, [](const FrameMsg& m) { return static_cast<std::size_t>(m.seq); }) {
+    level_nodes_.reserve(static_cast<std::size_t>(levels));
+    for (int level = 0; level < levels; ++level) {
+      level_nodes_.emplace_back(g, tf::unlimited, [this, level, levels, sigma](FrameMsg m) {
+        const BodyScope scope(run_.token());
+        if (level == 0) {
+          run_.admitted();
+          run_.enter(Stage::Pyramid, m.seq);
+        }
+        const auto start = Clock::now();
+        flow::Pyramid& pyr = *m.pyramid;
+        if (level == 0) {
+          flow::build_pyramid(m.frame->gray, 1, sigma, pyr);
+          pyr.levels.resize(
+              static_cast<std::size_t>(flow::effective_levels(m.frame->gray.size(), levels)));
+        } else if (level < pyr.num_levels()) {
+          cv::pyrDown(pyr.levels[level - 1], pyr.levels[level]);
+        }
+        run_.time("pyramid", start);
+        return m;
+      });
+    }
+    tf::make_edge(input_, limiter_);
+    tf::make_edge(limiter_, level_nodes_.front());
+    for (std::size_t i = 1; i < level_nodes_.size(); ++i)
+      tf::make_edge(level_nodes_[i - 1], level_nodes_[i]);
+    tf::make_edge(level_nodes_.back(), sequencer_);
+  }
+
+  tf::sequencer_node<FrameMsg>& output() { return sequencer_; }
+  tf::receiver<tf::continue_msg>& retire_port() { return limiter_.decrementer(); }
+  void start() { input_.activate(); }
+  bool cancelled() const { return cancelled_; }
+
+ private:
+  FrameMsg next(oneapi::tbb::flow_control& fc) {
+    const BodyScope scope(run_.token());
+    if (run_.cancel_requested()) {
+      cancelled_ = true;
+      fc.stop();
+      return {};
+    }
+    run_.enter(Stage::Source, seq_);
+    const auto start = Clock::now();
+    std::optional<stages::Frame> frame = source_();
+    if (!frame) {
+      fc.stop();
+      return {};
+    }
+    run_.time("decode", start);
+    FrameMsg m;
+    m.seq = seq_++;
+    m.frame = std::make_shared<const stages::Frame>(std::move(*frame));
+    m.pyramid = std::make_shared<flow::Pyramid>();
+    return m;
+  }
+
+  Run& run_;
+  const FrameSource& source_;
+  long long seq_ = 0;  // the input node's body runs serially
+  bool cancelled_ = false;
+  tf::input_node<FrameMsg> input_;
+  tf::limiter_node<FrameMsg> limiter_;
+  std::vector<tf::function_node<FrameMsg, FrameMsg>> level_nodes_;
+  tf::sequencer_node<FrameMsg> sequencer_;
+};
+
+using RetireNode = tf::multifunction_node<RetireMsg, std::tuple<tf::continue_msg>>;
+
+RetireNode make_retire_node(tf::graph& g, Run& run, int votes_needed) {
+  return RetireNode(g, tf::serial, [&run, votes_needed](const RetireMsg& m, auto& ports) {
+    const BodyScope scope(run.token());
+    if (run.vote(m, votes_needed)) std::get<0>(ports).try_put(tf::continue_msg());
+  });
+}
+
+// Runs `body` (which builds the graph, starts it and waits) in an arena of the options'
+// thread count, and times it.
+template <class Body>
+RunReport run_in_arena(const GraphOptions& options, Body&& body) {
+  const int threads = thread_count(options);
+  const int limit = in_flight_limit(options, threads);
+  ThreadScope scope(threads);
+  const auto start = Clock::now();
+  return scope.run([&] { return body(limit, start); });
+}
+
+}  // namespace
+
+const char* to_string(Stage stage) {
+  switch (stage) {
+    case Stage::Source:
+      return "source";
+    case Stage::Pyramid:
+      return "pyramid";
+    case Stage::Track:
+      return "track";
+    case Stage::Flow:
+      return "flow";
+    case Stage::Sink:
+      return "sink";
+  }
+  return "?";
+}
+
+RunReport run_tracking(const FrameSource& source, stages::Tracker& tracker,
+                       const std::vector<TrackSink>& sinks, const GraphOptions& options) {
+  TrackStep step;
+  step.levels = tracker.pyramid_levels();
+  step.sigma = tracker.pyramid_sigma();
+  step.process = [&tracker](const stages::TrackerInput& in) { return tracker.process(in); };
+  return run_tracking(source, step, sinks, options);
+}
+
+RunReport run_tracking(const FrameSource& source, const TrackStep& step,
+                       const std::vector<TrackSink>& sinks, const GraphOptions& options) {
+  if (!step.process) throw Error("tracking step without a process function");
+  return run_in_arena(options, [&](int limit, Clock::time_point start) {
+    Run run(options);
+    tf::graph g;
+    FrontEnd front(g, run, source, limit, step.levels, step.sigma);
+
+    tf::function_node<FrameMsg, TrackedFrame> track(g, tf::serial, [&](const FrameMsg& m) {
+      const BodyScope scope(run.token());
+      run.enter(Stage::Track, m.seq);
+      const auto t0 = Clock::now();
+      TrackedFrame out;
+      out.seq = m.seq;
+      out.frame = m.frame;
+      out.output = std::make_shared<const stages::TrackerOutput>(
+          step.process({m.frame->index, m.frame->image, m.frame->gray,
+                        std::const_pointer_cast<const flow::Pyramid>(m.pyramid)}));
+      run.time("track", t0);
+      return out;
+    });
+
+    // One serial node per sink, so that each sees the frames in order while different sinks
+    // work on different frames at once. With no sink, a pass-through retires the frames.
+    std::vector<tf::function_node<TrackedFrame, RetireMsg>> sink_nodes;
+    sink_nodes.reserve(std::max<std::size_t>(1, sinks.size()));
+    for (const TrackSink& sink : sinks) {
+      sink_nodes.emplace_back(g, tf::serial, [&run, &sink](const TrackedFrame& f) {
+        const BodyScope scope(run.token());
+        run.enter(Stage::Sink, f.seq);
+        const auto t0 = Clock::now();
+        sink.consume(f);
+        run.time(sink.name, t0);
+        return RetireMsg{f.seq, 1};
+      });
+    }
+    if (sinks.empty()) {
+      sink_nodes.emplace_back(g, tf::serial, [](const TrackedFrame& f) {
+        return RetireMsg{f.seq, 1};
+      });
+    }
+    RetireNode retire = make_retire_node(g, run, static_cast<int>(sink_nodes.size()));
+
+    tf::make_edge(front.output(), track);
+    for (auto& node : sink_nodes) {
+      tf::make_edge(track, node);
+      tf::make_edge(node, retire);
+    }
+    tf::make_edge(tf::output_port<0>(retire), front.retire_port());
+
+    front.start();
+    g.wait_for_all();
+    return run.report(std::chrono::duration<double>(Clock::now() - start).count(),
+                      front.cancelled());
+  });
+}
+
+RunReport run_dense(const FrameSource& source, const flow::LkParams& params,
+                    const std::vector<FlowSink>& sinks, const GraphOptions& options) {
+  params.validate();
+  return run_in_arena(options, [&](int limit, Clock::time_point start) {
+    Run run(options);
+    TbbExecutor tiles;
+    tf::graph g;
+    FrontEnd front(g, run, source, limit, params.levels, params.sigma);
+
+    struct PairJob {
+      long long seq = 0;
+      FrameMsg t, t1;
+    };
+    // Pairs each frame with the previous one. Frame 0 is retired at once (this node keeps it
+    // as `previous`); frame t+1 is retired when the sinks are done with pair (t, t+1).
+    using PairNode = tf::multifunction_node<FrameMsg, std::tuple<PairJob, RetireMsg>>;
+    std::optional<FrameMsg> previous;
+    PairNode pair(g, tf::serial, [&](const FrameMsg& m, PairNode::output_ports_type& ports) {
+      const BodyScope scope(run.token());
+      if (previous) {
+        std::get<0>(ports).try_put(PairJob{previous->seq, *previous, m});
+      } else {
+        std::get<1>(ports).try_put(
+            RetireMsg{m.seq, static_cast<int>(std::max<std::size_t>(1, sinks.size()))});
+      }
+      previous = m;
+    });
+
+    tf::function_node<PairJob, FlowPair> flow_node(g, tf::unlimited, [&](const PairJob& job) {
+      const BodyScope scope(run.token());
+      run.enter(Stage::Flow, job.seq);
+      const auto t0 = Clock::now();
+      auto result = std::make_shared<flow::FlowResult>();
+      flow::FlowOptions flow_options;
+      flow_options.executor = &tiles;
+      flow::dense_flow(*job.t.pyramid, *job.t1.pyramid, params, *result, flow_options);
+      run.time("flow", t0);
+      return FlowPair{job.seq, job.t.frame, job.t1.frame, std::move(result)};
+    });
+    tf::sequencer_node<FlowPair> pair_order(
+        g, [](const FlowPair& p) { return static_cast<std::size_t>(p.seq); });
+    tf::broadcast_node<FlowPair> to_sinks(g);  // a sequencer feeds one successor only
+
+    // Sinks vote for frame t+1, the newer frame of their pair.
+    std::vector<tf::function_node<FlowPair, RetireMsg>> sink_nodes;
+    sink_nodes.reserve(std::max<std::size_t>(1, sinks.size()));
+    for (const FlowSink& sink : sinks) {
+      sink_nodes.emplace_back(g, tf::serial, [&run, &sink](const FlowPair& p) {
+        const BodyScope scope(run.token());
+        run.enter(Stage::Sink, p.seq);
+        const auto t0 = Clock::now();
+        sink.consume(p);
+        run.time(sink.name, t0);
+        return RetireMsg{p.seq + 1, 1};
+      });
+    }
+    if (sinks.empty()) {
+      sink_nodes.emplace_back(g, tf::serial, [](const FlowPair& p) {
+        return RetireMsg{p.seq + 1, 1};
+      });
+    }
+    RetireNode retire = make_retire_node(g, run, static_cast<int>(sink_nodes.size()));
+
+    tf::make_edge(front.output(), pair);
+    tf::make_edge(tf::output_port<0>(pair), flow_node);
+    tf::make_edge(tf::output_port<1>(pair), retire);
+    tf::make_edge(flow_node, pair_order);
+    tf::make_edge(pair_order, to_sinks);
+    for (auto& node : sink_nodes) {
+      tf::make_edge(to_sinks, node);
+      tf::make_edge(node, retire);
+    }
+    tf::make_edge(tf::output_port<0>(retire), front.retire_port());
+
+    front.start();
+    g.wait_for_all();
+    return run.report(std::chrono::duration<double>(Clock::now() - start).count(),
+                      front.cancelled());
+  });
+}
+
+}  // namespace roiflow::pipeline

@@ -1,0 +1,120 @@
+// The oneTBB flow graphs that run roiflow over a video: tracking mode and dense mode.
+//
+//   using namespace roiflow;
+//   stages::VideoSource source("car.mp4");
+//   pipeline::TbbExecutor tiles;                       // LK over row tiles of the region
+//   stages::Tracker tracker(params, &tiles);
+//   stages::TrackLogWriter log("track.csv");
+//   pipeline::GraphOptions options;
+//   options.threads = 4;
+//   pipeline::RunReport report = pipeline::run_tracking(
+//       [&] { return source.next(); }, tracker,
+//       {{"log", [&](const pipeline::TrackedFrame& f) { log.write(f.output->record()); }}},
+//       options);
+//
+// Tracking mode (DESIGN.md, "Data flow"):
+//   source ─► limiter ─► pyramid level 0 ─► level 1 ─► … ─► sequencer ─► tracker (serial)
+//                                                                           │
+//                        limiter ◄─ retire ◄─ sinks (one serial node each) ◄─┘ broadcast
+// Decoding and the pyramids of later frames run ahead of the tracker (different frames and
+// different levels of different frames at once), bounded by the limiter: at most
+// `max_in_flight` frames exist between the source and their retirement, whatever the length of
+// the stream. The tracker is the serial critical path (its region for frame t+1 comes from its
+// decision at t); it parallelises inside through the TbbExecutor it was given (row tiles of
+// the region). Every sink sees every frame exactly once, in order; a frame is retired when all
+// sinks are done with it.
+//
+// Dense mode: the same front end, then a serial node that pairs each frame with the previous
+// one (each pyramid serves two pairs, built once), a flow node that runs several pairs at once
+// (each split in row tiles too), a sequencer that restores pair order, and the sinks.
+//
+// Errors: an exception in the source, a stage or a sink cancels the graph; the run function
+// waits for the nodes already running, then rethrows it (so the caller reports it; sinks keep
+// what they have written). Cancellation: when `*options.cancel` becomes true the source stops
+// reading, the frames already in flight are finished, and the report says cancelled.
+#pragma once
+
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "flow/dense_lk.hpp"
+#include "flow/pyramid.hpp"
+#include "stages/run_stats.hpp"
+#include "stages/tracker.hpp"
+#include "stages/video_source.hpp"
+
+namespace roiflow::pipeline {
+
+// Frames in order; std::nullopt at the end. Called from one thread at a time.
+using FrameSource = std::function<std::optional<stages::Frame>()>;
+
+// The stages a test hook sees, in the order a frame meets them.
+enum class Stage { Source, Pyramid, Track, Flow, Sink };
+
+struct GraphOptions {
+  int threads = 0;        // worker threads (a task_arena of this size); 0 = all hardware threads
+  int max_in_flight = 0;  // frames between source and retirement; 0 = 2 * threads + 2
+  const std::atomic<bool>* cancel = nullptr;  // set to stop reading; frames in flight finish
+  stages::RunStats* stats = nullptr;          // per-stage times ("decode", "pyramid", ...)
+  // Called at the start of every stage body with the frame's sequence number (tests inject
+  // delays and failures here). Must be thread-safe.
+  std::function<void(Stage, long long seq)> on_stage;
+};
+
+struct RunReport {
+  long long frames = 0;         // frames that went through the whole graph
+  long long max_in_flight = 0;  // the most frames alive at once (never above the limit)
+  bool cancelled = false;
+  double wall_s = 0;
+};
+
+// ------------------------------------------------------------------------------- tracking mode
+
+struct TrackedFrame {
+  long long seq = 0;  // 0-based order of arrival from the source
+  std::shared_ptr<const stages::Frame> frame;
+  std::shared_ptr<const stages::TrackerOutput> output;
+};
+
+struct TrackSink {
+  std::string name;  // for statistics: "log", "video", ...
+  std::function<void(const TrackedFrame&)> consume;
+};
+
+RunReport run_tracking(const FrameSource& source, stages::Tracker& tracker,
+                       const std::vector<TrackSink>& sinks, const GraphOptions& options = {});
+
+// The same with any serial per-frame step in the tracker's place (it gets each frame with its
+// pyramid of `levels` levels smoothed by `sigma`, in order).
+struct TrackStep {
+  int levels = 3;
+  double sigma = 0.5;
+  std::function<stages::TrackerOutput(const stages::TrackerInput&)> process;
+};
+RunReport run_tracking(const FrameSource& source, const TrackStep& step,
+                       const std::vector<TrackSink>& sinks, const GraphOptions& options = {});
+
+// ---------------------------------------------------------------------------------- dense mode
+
+struct FlowPair {
+  long long seq = 0;  // sequence number of frame t (the first pair is 0)
+  std::shared_ptr<const stages::Frame> frame_t;
+  std::shared_ptr<const stages::Frame> frame_t1;
+  std::shared_ptr<const flow::FlowResult> flow;  // whole-frame flow t -> t+1
+};
+
+struct FlowSink {
+  std::string name;
+  std::function<void(const FlowPair&)> consume;
+};
+
+RunReport run_dense(const FrameSource& source, const flow::LkParams& params,
+                    const std::vector<FlowSink>& sinks, const GraphOptions& options = {});
+
+const char* to_string(Stage stage);
+
+}  // namespace roiflow::pipeline
