@@ -12,3 +12,8 @@ if [[ -d ../shared/data/middlebury ]]; then
 else
   echo "test: ../shared/data/middlebury not found, real-data accuracy gates skipped"
 fi
+if [[ -d ../shared/data/tracking/Car4 ]]; then
+  scripts/track_gate.sh ../shared/data/tracking/Car4
+else
+  echo "test: ../shared/data/tracking/Car4 not found, tracking gate skipped"
+fi
