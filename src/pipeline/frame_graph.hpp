@@ -26,7 +26,8 @@
 //
 // Dense mode: the same front end, then a serial node that pairs each frame with the previous
 // one (each pyramid serves two pairs, built once), a flow node that runs several pairs at once
-// (each split in row tiles too), a sequencer that restores pair order, and the sinks.
+// (one thread each: more pairs are in flight than threads, and row tiles on top cost
+// throughput), a sequencer that restores pair order, and the sinks.
 //
 // Errors: an exception in the source, a stage or a sink cancels the graph; the run function
 // waits for the nodes already running, then rethrows it (so the caller reports it; sinks keep
