@@ -266,6 +266,40 @@ RetireNode make_retire_node(tf::graph& g, Run& run, int votes_needed) {
   });
 }
 
+// One serial node per sink, so that each sees the messages in order while different sinks
+// work on different ones at once; each votes for frame seq + `retire_offset`. With no sink, a
+// pass-through retires the frames.
+template <class Msg, class Sink>
+std::vector<tf::function_node<Msg, RetireMsg>> make_sink_nodes(tf::graph& g, Run& run,
+                                                               const std::vector<Sink>& sinks,
+                                                               long long retire_offset) {
+  std::vector<tf::function_node<Msg, RetireMsg>> nodes;
+  nodes.reserve(std::max<std::size_t>(1, sinks.size()));
+  for (const Sink& sink : sinks) {
+    nodes.emplace_back(g, tf::serial, [&run, &sink, retire_offset](const Msg& m) {
+      const BodyScope scope(run.token());
+      run.enter(Stage::Sink, m.seq);
+      const auto t0 = Clock::now();
+      sink.consume(m);
+      run.time(sink.name, t0);
+      return RetireMsg{m.seq + retire_offset, 1};
+    });
+  }
+  if (sinks.empty()) {
+    nodes.emplace_back(g, tf::serial, [retire_offset](const Msg& m) {
+      return RetireMsg{m.seq + retire_offset, 1};
+    });
+  }
+  return nodes;
+}
+
+// Starts the source, waits for the graph (rethrowing what a node threw) and reports.
+RunReport finish(tf::graph& g, Run& run, FrontEnd& front, Clock::time_point start) {
+  front.start();
+  g.wait_for_all();
+  return run.report(std::chrono::duration<double>(Clock::now() - start).count(), front.cancelled());
+}
+
 // Runs `body` (which builds the graph, starts it and waits) in an arena of the options'
 // thread count, and times it.
 template <class Body>
@@ -326,25 +360,7 @@ RunReport run_tracking(const FrameSource& source, const TrackStep& step,
       return out;
     });
 
-    // One serial node per sink, so that each sees the frames in order while different sinks
-    // work on different frames at once. With no sink, a pass-through retires the frames.
-    std::vector<tf::function_node<TrackedFrame, RetireMsg>> sink_nodes;
-    sink_nodes.reserve(std::max<std::size_t>(1, sinks.size()));
-    for (const TrackSink& sink : sinks) {
-      sink_nodes.emplace_back(g, tf::serial, [&run, &sink](const TrackedFrame& f) {
-        const BodyScope scope(run.token());
-        run.enter(Stage::Sink, f.seq);
-        const auto t0 = Clock::now();
-        sink.consume(f);
-        run.time(sink.name, t0);
-        return RetireMsg{f.seq, 1};
-      });
-    }
-    if (sinks.empty()) {
-      sink_nodes.emplace_back(g, tf::serial, [](const TrackedFrame& f) {
-        return RetireMsg{f.seq, 1};
-      });
-    }
+    auto sink_nodes = make_sink_nodes<TrackedFrame>(g, run, sinks, 0);
     RetireNode retire = make_retire_node(g, run, static_cast<int>(sink_nodes.size()));
 
     tf::make_edge(front.output(), track);
@@ -354,10 +370,7 @@ RunReport run_tracking(const FrameSource& source, const TrackStep& step,
     }
     tf::make_edge(tf::output_port<0>(retire), front.retire_port());
 
-    front.start();
-    g.wait_for_all();
-    return run.report(std::chrono::duration<double>(Clock::now() - start).count(),
-                      front.cancelled());
+    return finish(g, run, front, start);
   });
 }
 
@@ -405,23 +418,7 @@ RunReport run_dense(const FrameSource& source, const flow::LkParams& params,
     tf::broadcast_node<FlowPair> to_sinks(g);  // a sequencer feeds one successor only
 
     // Sinks vote for frame t+1, the newer frame of their pair.
-    std::vector<tf::function_node<FlowPair, RetireMsg>> sink_nodes;
-    sink_nodes.reserve(std::max<std::size_t>(1, sinks.size()));
-    for (const FlowSink& sink : sinks) {
-      sink_nodes.emplace_back(g, tf::serial, [&run, &sink](const FlowPair& p) {
-        const BodyScope scope(run.token());
-        run.enter(Stage::Sink, p.seq);
-        const auto t0 = Clock::now();
-        sink.consume(p);
-        run.time(sink.name, t0);
-        return RetireMsg{p.seq + 1, 1};
-      });
-    }
-    if (sinks.empty()) {
-      sink_nodes.emplace_back(g, tf::serial, [](const FlowPair& p) {
-        return RetireMsg{p.seq + 1, 1};
-      });
-    }
+    auto sink_nodes = make_sink_nodes<FlowPair>(g, run, sinks, 1);
     RetireNode retire = make_retire_node(g, run, static_cast<int>(sink_nodes.size()));
 
     tf::make_edge(front.output(), pair);
@@ -435,10 +432,7 @@ RunReport run_dense(const FrameSource& source, const flow::LkParams& params,
     }
     tf::make_edge(tf::output_port<0>(retire), front.retire_port());
 
-    front.start();
-    g.wait_for_all();
-    return run.report(std::chrono::duration<double>(Clock::now() - start).count(),
-                      front.cancelled());
+    return finish(g, run, front, start);
   });
 }
 
