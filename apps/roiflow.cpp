@@ -13,10 +13,12 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <opencv2/core/utils/logger.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <optional>
 #include <string>
@@ -333,6 +335,11 @@ int report_usage(const CLI::App& app, const std::string& message) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // The CLI promises one error line: OpenCV's and FFmpeg's own diagnostics (decoder complaints
+  // about a damaged file, backends that cannot open a camera) would add lines of their own, and
+  // every failure they describe reaches the user as roiflow's error anyway.
+  setenv("OPENCV_FFMPEG_LOGLEVEL", "-8", 0);  // AV_LOG_QUIET, unless the user set it
+  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
   CLI::App app{"roiflow: realtime dense and local Lucas-Kanade optical flow", "roiflow"};
   app.require_subcommand(1);
   FlowCommand flow_cmd;

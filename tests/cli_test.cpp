@@ -453,6 +453,24 @@ TEST_F(CliVideoTest, DemoTracksTheSceneAndPrintsItsError) {
   EXPECT_GE(summary.at("global_activations").get<long long>(), 1);
 }
 
+TEST_F(CliVideoTest, ATruncatedVideoStopsCleanlyWithOneLineAndKeepsWhatWasWritten) {
+  const std::string whole = read_text(path("scene.avi"));
+  std::ofstream(path("cut.avi"), std::ios::binary) << whole.substr(0, whole.size() / 2);
+  const CliResult r = run({"track", path("cut.avi"), "--init", init_box(), "--log", path("cut.csv"),
+                           "--summary", path("cut.json"), "--no-progress"});
+  // The summary of what was done goes to stdout as usual; stderr holds the one error line.
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(lines_of(r.err).size(), 1u) << r.err;
+  EXPECT_EQ(r.err.rfind("roiflow: error: input stopped at frame", 0), 0u) << r.err;
+  EXPECT_NE(r.out.find("frames in"), std::string::npos) << r.out;
+  const std::vector<stages::TrackRecord> log = stages::read_track_csv(path("cut.csv"));
+  EXPECT_GT(log.size(), 5u);
+  EXPECT_LT(log.size(), 30u);
+  const auto summary = nlohmann::json::parse(read_text(path("cut.json")));
+  EXPECT_EQ(summary.at("frames").get<std::size_t>(), log.size());
+  EXPECT_NE(summary.at("status").get<std::string>().find("stopped at frame"), std::string::npos);
+}
+
 TEST_F(CliVideoTest, BadVideoCommandLinesFailWithOneLine) {
   std::ofstream(path("garbage.avi"), std::ios::binary) << "not a video at all";
   struct Case {
