@@ -12,37 +12,13 @@
 
 #include "flow/error.hpp"
 #include "pipeline/tbb_executor.hpp"
+#include "pipeline/tsan_annotations.hpp"
 
 namespace roiflow::pipeline {
 namespace {
 
 namespace tf = oneapi::tbb::flow;
 using Clock = std::chrono::steady_clock;
-
-// ThreadSanitizer cannot see the synchronisation inside oneTBB when the library itself is not
-// instrumented (Debian's is not), so every message hand-over would look like a race. Each node
-// body therefore acquires a per-graph token when it starts and releases it when it ends: bodies
-// that ran one after the other are ordered, as TBB orders them; bodies that really overlapped
-// stay unordered, so a race between them is still reported.
-#if defined(__SANITIZE_THREAD__)
-extern "C" void __tsan_acquire(void* addr);
-extern "C" void __tsan_release(void* addr);
-class BodyScope {
- public:
-  explicit BodyScope(void* token) : token_(token) { __tsan_acquire(token_); }
-  ~BodyScope() { __tsan_release(token_); }
-  BodyScope(const BodyScope&) = delete;
-  BodyScope& operator=(const BodyScope&) = delete;
-
- private:
-  void* token_;
-};
-#else
-class BodyScope {
- public:
-  explicit BodyScope(void*) {}
-};
-#endif
 
 double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -297,6 +273,7 @@ std::vector<tf::function_node<Msg, RetireMsg>> make_sink_nodes(tf::graph& g, Run
 RunReport finish(tf::graph& g, Run& run, FrontEnd& front, Clock::time_point start) {
   front.start();
   g.wait_for_all();
+  tsan_acquire(run.token());  // every body's writes happen before the report reads them
   return run.report(std::chrono::duration<double>(Clock::now() - start).count(), front.cancelled());
 }
 
