@@ -312,6 +312,32 @@ TEST(DenseLkTest, RegionEqualsWholeFrameFlowInsideIt) {
   }
 }
 
+TEST(DenseLkTest, ASmallerContextChangesTheFlowOnlyNearTheRegionBorder) {
+  const Scene s = make_scene(SceneKind::Rotation, kSize, 4);
+  const cv::Rect region(110, 80, 90, 70);
+  FlowOptions exact;
+  exact.region = region;
+  const FlowResult reference = dense_flow(s.frame0, s.frame1, LkParams::paper(), exact);
+  FlowOptions small = exact;
+  small.context = 8;
+  const FlowResult cheap = dense_flow(s.frame0, s.frame1, LkParams::paper(), small);
+  ASSERT_EQ(cheap.flow.size(), region.size());
+  // Away from the border (more than a window and the context), the two agree closely; at the
+  // border they may not, which is why exact context stays the default.
+  const cv::Rect inner(20, 20, region.width - 40, region.height - 40);
+  EXPECT_LT(max_abs_diff(cheap.flow(inner), reference.flow(inner)), 0.05);
+  EXPECT_GT(max_abs_diff(cheap.flow, reference.flow), 1e-4);  // the context was honoured
+  EXPECT_LT(max_abs_diff(cheap.flow, s.flow(region)), 1.0);
+  for (int bad : {-2, 1001}) {
+    FlowOptions options = exact;
+    options.context = bad;
+    EXPECT_NE(error_message([&] {
+                dense_flow(s.frame0, s.frame1, LkParams::paper(), options);
+              }).find(std::to_string(bad)),
+              std::string::npos);
+  }
+}
+
 TEST(DenseLkTest, RegionOutsideTheFrameThrows) {
   const Scene s = make_scene(SceneKind::Translation, {160, 120}, 2);
   for (const cv::Rect region : {cv::Rect(160, 0, 10, 10), cv::Rect(-30, -30, 30, 30),

@@ -712,9 +712,14 @@ void flow_from_pyramids(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkPar
   // Flow at a pixel after one iteration depends on the previous flow within the window plus
   // the derivative stencil: computing on a margin of this many pixels per iteration makes a
   // region's flow equal the whole frame's flow inside the region (up to rounding).
+  if (options.context < -1 || options.context > 1000) {
+    throw Error("flow context must be in -1..1000 pixels, got " + std::to_string(options.context));
+  }
   const int reach = win.reach() + 2;
   const int margin =
-      params.iterations * reach + std::max(params.level_median, params.final_median) / 2;
+      options.context >= 0
+          ? options.context
+          : params.iterations * reach + std::max(params.level_median, params.final_median) / 2;
 
   std::vector<cv::Rect> comp(levels);
   cv::Rect need = region;

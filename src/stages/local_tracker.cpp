@@ -119,6 +119,7 @@ void LocalTrackerParams::validate() const {
   check_range("roi", roi, 8, 4096);
   lk.validate();
   check_range("max_points", max_points, 16, 1e6);
+  check_range("lk_context", lk_context, -1, 1000);
   check_range("fb_levels", fb_levels, 1, flow::kMaxLevels);
   if (!(fb_threshold > 0) || !std::isfinite(fb_threshold)) {
     throw Error("local tracker: fb_threshold must be > 0, got " + num(fb_threshold));
@@ -307,6 +308,7 @@ LocalResult LocalTracker::Impl::track(std::shared_ptr<const flow::Pyramid> pyram
   opt.region = r.region;
   opt.initial_motion = velocity;
   opt.executor = executor;
+  opt.context = params.lk_context;
   flow::dense_flow(*prev, cur, params.lk, forward, opt);
   r.region_flow = forward.flow.clone();
 
