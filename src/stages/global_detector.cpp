@@ -5,10 +5,10 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/background_segm.hpp>
-#include <sstream>
 #include <string>
 
 #include "flow/error.hpp"
+#include "stages/number_text.hpp"
 #include "stages/template_search.hpp"
 
 namespace roiflow::stages {
@@ -33,12 +33,6 @@ constexpr int kGrayBins = 32;
 constexpr int kColourBins = 8;   // per channel: 8^3 bins, coarse enough for lighting changes
 constexpr int kCoarseSide = 12;  // see by_appearance()
 constexpr int kHuUsed = 4;       // the higher Hu moments are dominated by contour noise
-
-std::string num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
 
 void check_image(const cv::Mat& image, const char* what) {
   if (image.empty() || image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3)) {
@@ -111,21 +105,22 @@ struct Blob {
 }  // namespace
 
 void GlobalDetectorParams::validate() const {
-  if (history < 2) throw Error("global detector: history must be >= 2, got " + num(history));
-  if (warmup < 0) throw Error("global detector: warmup must be >= 0, got " + num(warmup));
+  if (history < 2)
+    throw Error("global detector: history must be >= 2, got " + number_text(history));
+  if (warmup < 0) throw Error("global detector: warmup must be >= 0, got " + number_text(warmup));
   if (work_width < 0) {
-    throw Error("global detector: work_width must be >= 0, got " + num(work_width));
+    throw Error("global detector: work_width must be >= 0, got " + number_text(work_width));
   }
   if (!(min_area >= 0) || !std::isfinite(min_area)) {
-    throw Error("global detector: min_area must be >= 0, got " + num(min_area));
+    throw Error("global detector: min_area must be >= 0, got " + number_text(min_area));
   }
   if (!(min_score > 0 && min_score < 1)) {
-    throw Error("global detector: min_score must be in (0, 1), got " + num(min_score));
+    throw Error("global detector: min_score must be in (0, 1), got " + number_text(min_score));
   }
   if (appearance_scales.empty()) throw Error("global detector: appearance_scales is empty");
   for (double s : appearance_scales) {
     if (!(s > 0) || !std::isfinite(s)) {
-      throw Error("global detector: appearance scales must be positive, got " + num(s));
+      throw Error("global detector: appearance scales must be positive, got " + number_text(s));
     }
   }
 }
@@ -224,9 +219,9 @@ struct GlobalDetector::Impl {
   std::optional<Detection> by_signature(const cv::Mat& image, cv::Point2f near) const {
     if (frame_size.empty()) return std::nullopt;
     if (image.size() != frame_size) {
-      throw Error("global detector: frame size " + num(image.cols) + "x" + num(image.rows) +
-                  " differs from the observed frames' " + num(frame_size.width) + "x" +
-                  num(frame_size.height));
+      throw Error("global detector: frame size " + number_text(image.cols) + "x" +
+                  number_text(image.rows) + " differs from the observed frames' " +
+                  number_text(frame_size.width) + "x" + number_text(frame_size.height));
     }
     std::vector<Detection> candidates;
     for (Blob& b : blobs()) {
@@ -296,9 +291,9 @@ void GlobalDetector::observe(const cv::Mat& image) {
     s.to_full = cv::Point2d(static_cast<double>(image.cols) / s.work_size.width,
                             static_cast<double>(image.rows) / s.work_size.height);
   } else if (image.size() != s.frame_size) {
-    throw Error("global detector: frame size " + num(image.cols) + "x" + num(image.rows) +
-                " differs from the first frame's " + num(s.frame_size.width) + "x" +
-                num(s.frame_size.height));
+    throw Error("global detector: frame size " + number_text(image.cols) + "x" +
+                number_text(image.rows) + " differs from the first frame's " +
+                number_text(s.frame_size.width) + "x" + number_text(s.frame_size.height));
   }
   const cv::Mat* input = &image;
   if (s.work_size != s.frame_size) {
@@ -331,9 +326,10 @@ void GlobalDetector::set_target(const cv::Mat& image, const cv::Rect2f& box) {
                static_cast<int>(std::lround(box.height))) &
       cv::Rect(0, 0, image.cols, image.rows);
   if (r.width < 2 || r.height < 2) {
-    throw Error("global detector: target box (" + num(box.x) + ", " + num(box.y) + ", " +
-                num(box.width) + " x " + num(box.height) + ") leaves nothing inside the " +
-                num(image.cols) + " x " + num(image.rows) + " frame");
+    throw Error("global detector: target box (" + number_text(box.x) + ", " + number_text(box.y) +
+                ", " + number_text(box.width) + " x " + number_text(box.height) +
+                ") leaves nothing inside the " + number_text(image.cols) + " x " +
+                number_text(image.rows) + " frame");
   }
   Impl& s = *impl_;
   s.templ = to_gray(image(r)).clone();
@@ -372,8 +368,8 @@ cv::Size2f GlobalDetector::target_size() const {
 
 void GlobalDetector::set_target_size(cv::Size2f size) {
   if (!(size.width > 0 && size.height > 0)) {
-    throw Error("global detector: target size must be positive, got " + num(size.width) + " x " +
-                num(size.height));
+    throw Error("global detector: target size must be positive, got " + number_text(size.width) +
+                " x " + number_text(size.height));
   }
   impl_->size = size;
 }
@@ -395,8 +391,9 @@ std::optional<Detection> GlobalDetector::find_target(const cv::Mat& image, const
   }
   check_image(image, "frame");
   if (image.channels() != s.signature.channels) {
-    throw Error("global detector: the target was captured from a " + num(s.signature.channels) +
-                "-channel image, got a " + num(image.channels()) + "-channel one");
+    throw Error("global detector: the target was captured from a " +
+                number_text(s.signature.channels) + "-channel image, got a " +
+                number_text(image.channels()) + "-channel one");
   }
   return s.by_signature(image, near);
 }

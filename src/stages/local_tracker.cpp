@@ -4,25 +4,19 @@
 #include <cmath>
 #include <cstdint>
 #include <opencv2/imgproc.hpp>
-#include <sstream>
 #include <utility>
 
 #include "flow/error.hpp"
+#include "stages/number_text.hpp"
 #include "stages/template_search.hpp"
 
 namespace roiflow::stages {
 namespace {
 
-std::string num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 void check_range(const char* name, double value, double lo, double hi) {
   if (!(value >= lo && value <= hi)) {
-    throw Error(std::string("local tracker: ") + name + " must be in [" + num(lo) + ", " + num(hi) +
-                "], got " + num(value));
+    throw Error(std::string("local tracker: ") + name + " must be in [" + number_text(lo) + ", " +
+                number_text(hi) + "], got " + number_text(value));
   }
 }
 
@@ -122,24 +116,25 @@ void LocalTrackerParams::validate() const {
   check_range("lk_context", lk_context, -1, 1000);
   check_range("fb_levels", fb_levels, 1, flow::kMaxLevels);
   if (!(fb_threshold > 0) || !std::isfinite(fb_threshold)) {
-    throw Error("local tracker: fb_threshold must be > 0, got " + num(fb_threshold));
+    throw Error("local tracker: fb_threshold must be > 0, got " + number_text(fb_threshold));
   }
   if (!(min_inliers >= 0 && min_inliers < 1)) {
-    throw Error("local tracker: min_inliers must be in [0, 1), got " + num(min_inliers));
+    throw Error("local tracker: min_inliers must be in [0, 1), got " + number_text(min_inliers));
   }
   if (!(min_texture >= 0) || !std::isfinite(min_texture)) {
-    throw Error("local tracker: min_texture must be >= 0, got " + num(min_texture));
+    throw Error("local tracker: min_texture must be >= 0, got " + number_text(min_texture));
   }
   if (!(min_appearance >= -1 && min_appearance < 1)) {
-    throw Error("local tracker: min_appearance must be in [-1, 1), got " + num(min_appearance));
+    throw Error("local tracker: min_appearance must be in [-1, 1), got " +
+                number_text(min_appearance));
   }
   check_range("trust_appearance", trust_appearance, min_appearance, 1);
   check_range("appearance_weight", appearance_weight, 0, 1);
   if (!(search > 0 && search <= 2)) {
-    throw Error("local tracker: search must be in (0, 2], got " + num(search));
+    throw Error("local tracker: search must be in (0, 2], got " + number_text(search));
   }
   if (!(scale_step > 0 && scale_step < 0.5)) {
-    throw Error("local tracker: scale_step must be in (0, 0.5), got " + num(scale_step));
+    throw Error("local tracker: scale_step must be in (0, 0.5), got " + number_text(scale_step));
   }
   check_range("scale_steps", scale_steps, 0, 10);
   check_range("match_side", match_side, 8, 256);
@@ -184,15 +179,17 @@ struct LocalTracker::Impl {
     if (!pyramid || pyramid->levels.empty()) throw Error("local tracker: empty pyramid");
     if (!(std::isfinite(b.x) && std::isfinite(b.y) && b.width >= 2 && b.height >= 2 &&
           std::isfinite(b.width) && std::isfinite(b.height))) {
-      throw Error("local tracker: box (" + num(b.x) + ", " + num(b.y) + ", " + num(b.width) +
-                  " x " + num(b.height) + ") must be finite with sides of at least 2 pixels");
+      throw Error("local tracker: box (" + number_text(b.x) + ", " + number_text(b.y) + ", " +
+                  number_text(b.width) + " x " + number_text(b.height) +
+                  ") must be finite with sides of at least 2 pixels");
     }
     const cv::Size size = pyramid->size();
     const cv::Rect inside = enclosing(b) & cv::Rect(cv::Point(), size);
     if (inside.width < 2 || inside.height < 2) {
-      throw Error("local tracker: box (" + num(b.x) + ", " + num(b.y) + ", " + num(b.width) +
-                  " x " + num(b.height) + ") leaves nothing inside the " + num(size.width) + " x " +
-                  num(size.height) + " frame");
+      throw Error("local tracker: box (" + number_text(b.x) + ", " + number_text(b.y) + ", " +
+                  number_text(b.width) + " x " + number_text(b.height) +
+                  ") leaves nothing inside the " + number_text(size.width) + " x " +
+                  number_text(size.height) + " frame");
     }
     prev = std::move(pyramid);
     box = b;
@@ -271,9 +268,9 @@ LocalResult LocalTracker::Impl::track(std::shared_ptr<const flow::Pyramid> pyram
   if (!prev) throw Error("local tracker: track() before start()");
   if (!pyramid || pyramid->size() != prev->size()) {
     const cv::Size got = pyramid ? pyramid->size() : cv::Size();
-    throw Error("local tracker: frame is " + num(got.width) + " x " + num(got.height) +
-                ", the previous one was " + num(prev->size().width) + " x " +
-                num(prev->size().height));
+    throw Error("local tracker: frame is " + number_text(got.width) + " x " +
+                number_text(got.height) + ", the previous one was " +
+                number_text(prev->size().width) + " x " + number_text(prev->size().height));
   }
   const flow::Pyramid& cur = *pyramid;
   const cv::Rect frame(cv::Point(), cur.size());

@@ -3,29 +3,24 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
 #include "flow/error.hpp"
+#include "stages/number_text.hpp"
 
 namespace roiflow::stages {
 namespace {
 
-std::string num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 std::string size_text(cv::Size s) {
-  return num(s.width) + " x " + num(s.height);
+  return number_text(s.width) + " x " + number_text(s.height);
 }
 
 std::string box_text(const cv::Rect2f& b) {
-  return "(" + num(b.x) + ", " + num(b.y) + ", " + num(b.width) + " x " + num(b.height) + ")";
+  return "(" + number_text(b.x) + ", " + number_text(b.y) + ", " + number_text(b.width) + " x " +
+         number_text(b.height) + ")";
 }
 
 cv::Point2f centre(const cv::Rect2f& r) {
@@ -126,7 +121,8 @@ cv::Rect2f refine_by_motion(const flow::Pyramid& previous, const flow::Pyramid& 
 }  // namespace
 
 void TrackerParams::validate() const {
-  if (roi < 8 || roi > 4096) throw Error("tracker: roi must be in 8..4096, got " + num(roi));
+  if (roi < 8 || roi > 4096)
+    throw Error("tracker: roi must be in 8..4096, got " + number_text(roi));
   lk.validate();
   if (init) {
     const cv::Rect2f& b = *init;
@@ -138,7 +134,7 @@ void TrackerParams::validate() const {
   }
   local.validate();
   if (!(camera_motion > 0) || !std::isfinite(camera_motion)) {
-    throw Error("tracker: camera_motion must be > 0, got " + num(camera_motion));
+    throw Error("tracker: camera_motion must be > 0, got " + number_text(camera_motion));
   }
   if (observe_interval < 1 || observe_interval > 1000) {
     throw Error("tracker: observe_interval must be in 1..1000, got " +
@@ -273,22 +269,22 @@ TrackerOutput Tracker::Impl::process(const TrackerInput& frame) {
   const auto t0 = std::chrono::steady_clock::now();
   if (frame.gray.empty() || frame.gray.type() != CV_8UC1) {
     throw Error(
-        "tracker: frame " + num(static_cast<double>(frame.index)) +
+        "tracker: frame " + number_text(static_cast<double>(frame.index)) +
         ": gray must be 8-bit single-channel, got " +
         (frame.gray.empty() ? std::string("an empty image") : cv::typeToString(frame.gray.type())));
   }
   if (size.empty()) size = frame.gray.size();
   if (frame.gray.size() != size) {
-    throw Error("tracker: frame " + num(static_cast<double>(frame.index)) + " is " +
+    throw Error("tracker: frame " + number_text(static_cast<double>(frame.index)) + " is " +
                 size_text(frame.gray.size()) + ", the first frame was " + size_text(size));
   }
   if (!frame.image.empty() && frame.image.size() != size) {
-    throw Error("tracker: frame " + num(static_cast<double>(frame.index)) + ": image is " +
+    throw Error("tracker: frame " + number_text(static_cast<double>(frame.index)) + ": image is " +
                 size_text(frame.image.size()) + " but gray is " + size_text(size));
   }
   if (!frame.pyramid || frame.pyramid->size() != size ||
       frame.pyramid->num_levels() < flow::effective_levels(size, params.lk.levels)) {
-    throw Error("tracker: frame " + num(static_cast<double>(frame.index)) +
+    throw Error("tracker: frame " + number_text(static_cast<double>(frame.index)) +
                 ": the pyramid must be built from gray with pyramid_levels() levels");
   }
   if (!has_target || lost || frame.index % params.observe_interval == 0) observe(frame);
