@@ -81,6 +81,14 @@ class CliTest : public test::TempDirTest {
     return result;
   }
 
+  struct FailureCase {
+    std::vector<std::string> args;
+    int exit_code;
+    std::string expected;  // in the error line
+  };
+  // Each command line fails with one error line holding `expected` and the exit code given.
+  void expect_failures(const std::vector<FailureCase>& cases) const;
+
   void write_image(const std::string& relative, const cv::Mat& image) const {
     fs::create_directories(fs::path(path(relative)).parent_path());
     ASSERT_TRUE(cv::imwrite(path(relative), image));
@@ -102,6 +110,18 @@ void expect_one_line_error(const CliResult& r, int exit_code) {
   ASSERT_EQ(lines.size(), 1u) << r.err;
   EXPECT_EQ(lines[0].rfind("roiflow: error: ", 0), 0u) << lines[0];
   EXPECT_TRUE(r.out.empty()) << r.out;
+}
+
+void CliTest::expect_failures(const std::vector<FailureCase>& cases) const {
+  for (const FailureCase& c : cases) {
+    std::string shown;
+    for (const std::string& arg : c.args)
+      shown += " " + arg;
+    SCOPED_TRACE("roiflow" + shown);
+    const CliResult r = run(c.args);
+    expect_one_line_error(r, c.exit_code);
+    EXPECT_NE(r.err.find(c.expected), std::string::npos) << r.err;
+  }
 }
 
 TEST_F(CliTest, FlowSyntheticWritesReadableFlowAndColour) {
@@ -324,12 +344,7 @@ TEST_F(CliScoreTest, BadInputsFailWithOneLine) {
       << "frame,x,y,w,h,vx,vy,mode,lost,ms\n1,1,2,3,4,0,0,local,0,1\n3,1,2,3,4,0,0,local,0,1\n";
   std::ofstream(path("bad_gt.txt"), std::ios::binary) << "1,2,3,4\n1,2,three,4\n";
   std::ofstream(path("absent_gt.txt"), std::ios::binary) << "0,0,0,0\nNaN,NaN,NaN,NaN\n";
-  struct Case {
-    std::vector<std::string> args;
-    int exit_code;
-    std::string expected;  // in the error line
-  };
-  const std::vector<Case> cases = {
+  const std::vector<FailureCase> cases = {
       {{"score", path("missing.csv"), path("gt.txt")}, 1, path("missing.csv")},
       {{"score", path("track.csv"), path("missing.txt")}, 1, path("missing.txt")},
       {{"score", path("bad_header.csv"), path("gt.txt")}, 1, path("bad_header.csv") + ":1:"},
@@ -339,15 +354,7 @@ TEST_F(CliScoreTest, BadInputsFailWithOneLine) {
       {{"score", path("track.csv")}, 2, "GROUNDTRUTH"},
       {{"score", path("track.csv"), path("gt.txt"), "--format", "csv"}, 2, "--format"},
   };
-  for (const Case& c : cases) {
-    std::string shown;
-    for (const std::string& arg : c.args)
-      shown += " " + arg;
-    SCOPED_TRACE("roiflow" + shown);
-    const CliResult r = run(c.args);
-    expect_one_line_error(r, c.exit_code);
-    EXPECT_NE(r.err.find(c.expected), std::string::npos) << r.err;
-  }
+  expect_failures(cases);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -473,12 +480,7 @@ TEST_F(CliVideoTest, ATruncatedVideoStopsCleanlyWithOneLineAndKeepsWhatWasWritte
 
 TEST_F(CliVideoTest, BadVideoCommandLinesFailWithOneLine) {
   std::ofstream(path("garbage.avi"), std::ios::binary) << "not a video at all";
-  struct Case {
-    std::vector<std::string> args;
-    int exit_code;
-    std::string expected;  // in the error line
-  };
-  const std::vector<Case> cases = {
+  const std::vector<FailureCase> cases = {
       {{"track", path("missing.avi")}, 1, path("missing.avi")},
       {{"track", path("garbage.avi")}, 1, path("garbage.avi")},
       {{"track", path("scene.avi"), "--init", "1,2,3"}, 2, "--init"},
@@ -492,15 +494,7 @@ TEST_F(CliVideoTest, BadVideoCommandLinesFailWithOneLine) {
       {{"dense", path("scene.avi"), "--out", path("x.avi"), "--patch", "2"}, 2, "--patch"},
       {{"demo", "--frames", "1"}, 2, "--frames"},
   };
-  for (const Case& c : cases) {
-    std::string shown;
-    for (const std::string& arg : c.args)
-      shown += " " + arg;
-    SCOPED_TRACE("roiflow" + shown);
-    const CliResult r = run(c.args);
-    expect_one_line_error(r, c.exit_code);
-    EXPECT_NE(r.err.find(c.expected), std::string::npos) << r.err;
-  }
+  expect_failures(cases);
   EXPECT_FALSE(fs::exists(path("track.txt")));
 }
 
