@@ -3,6 +3,7 @@
 //   roiflow flow --synthetic -o out.flo --color out.png
 //   roiflow flow A.png B.png -o out.flo --gt truth.flo
 //   roiflow eval data/middlebury --format csv -o errors.csv
+//   roiflow eval data/sintel/training --pass final --max-pairs 50 --report sintel.html
 //   roiflow score track.csv Car4/groundtruth_rect.txt --format json
 //
 // Each subcommand is a thin layer: CLI11 parses, the library computes, this file prints.
@@ -35,8 +36,10 @@
 #include "pipeline/tbb_executor.hpp"
 #include "stages/atomic_write.hpp"
 #include "stages/flow_eval.hpp"
+#include "stages/html_report.hpp"
 #include "stages/otb_score.hpp"
 #include "stages/track_log.hpp"
+#include "stages/video_source.hpp"
 
 namespace {
 
@@ -94,8 +97,15 @@ void run_flow(const FlowCommand& cmd) {
     truth = scene.flow;
     source = "synthetic " + cmd.scene;
   } else {
+    for (const std::string& image : {cmd.frame0, cmd.frame1}) {
+      std::error_code ec;
+      if (std::filesystem::is_directory(image, ec))
+        throw Error("image '" + image + "' is a directory, not an image file");
+    }
     frame0 = stages::read_gray(cmd.frame0);
+    stages::check_frame_size(frame0.size(), "image '" + cmd.frame0 + "'");
     frame1 = stages::read_gray(cmd.frame1);
+    stages::check_frame_size(frame1.size(), "image '" + cmd.frame1 + "'");
     if (frame0.size() != frame1.size()) {
       throw Error("'" + cmd.frame0 + "' is " + size_string(frame0.size()) + " but '" + cmd.frame1 +
                   "' is " + size_string(frame1.size()));
@@ -175,15 +185,28 @@ struct EvalCommand {
   std::string dir;
   std::vector<std::vector<std::string>> pairs;  // A, B, ground truth
   std::vector<std::string> exclude_masks;
+  std::string layout = "auto";
+  std::string pass = "clean";
+  std::string scene;
+  int max_pairs = 0;
   std::string format = "table";
   std::string output;
+  std::string report;
 };
 
 std::vector<stages::EvalPair> eval_pairs(const EvalCommand& cmd) {
   if (cmd.dir.empty() && cmd.pairs.empty()) {
-    throw UsageError("eval needs a Middlebury directory DIR or at least one --pair A B GT");
+    throw UsageError(
+        "eval needs a Middlebury, Sintel or KITTI directory DIR or at least one --pair A B GT");
   }
-  if (!cmd.dir.empty()) return stages::find_middlebury(cmd.dir);
+  if (!cmd.dir.empty()) {
+    stages::FindOptions options;
+    options.layout = stages::parse_layout(cmd.layout);
+    options.pass = cmd.pass;
+    options.scene = cmd.scene;
+    options.max_pairs = cmd.max_pairs;
+    return stages::find_pairs(cmd.dir, options);
+  }
   if (!cmd.exclude_masks.empty() && cmd.exclude_masks.size() != cmd.pairs.size()) {
     throw UsageError("--exclude-mask: got " + std::to_string(cmd.exclude_masks.size()) +
                      " masks for " + std::to_string(cmd.pairs.size()) +
@@ -200,14 +223,23 @@ std::vector<stages::EvalPair> eval_pairs(const EvalCommand& cmd) {
 
 void run_eval(const EvalCommand& cmd) {
   const flow::LkParams params = lk_params(cmd.lk);
-  const std::vector<stages::EvalPair> pairs = eval_pairs(cmd);
   if (!cmd.output.empty()) check_output_path(cmd.output, "-o");
+  if (!cmd.report.empty()) check_output_path(cmd.report, "--report");
+  const std::vector<stages::EvalPair> pairs = eval_pairs(cmd);
 
+  std::optional<stages::HtmlReport> report;
+  if (!cmd.report.empty()) {
+    report.emplace("roiflow eval " + (cmd.dir.empty() ? std::string("--pair") : cmd.dir),
+                   cmd.lk.preset, params);
+  }
   const pipeline::TbbExecutor executor;
   std::vector<stages::EvalRow> rows;
   pipeline::run_with_threads(cmd.lk.threads, [&] {
-    for (const stages::EvalPair& pair : pairs)
-      rows.push_back(stages::evaluate_pair(pair, params, &executor));
+    for (const stages::EvalPair& pair : pairs) {
+      stages::EvalImages images;
+      rows.push_back(stages::evaluate_pair(pair, params, &executor, report ? &images : nullptr));
+      if (report) report->add(rows.back(), images);
+    }
   });
 
   std::string text;
@@ -218,37 +250,67 @@ void run_eval(const EvalCommand& cmd) {
   } else {
     text = stages::format_table(rows);
   }
+  if (report) report->write(cmd.report);
   if (cmd.output.empty()) {
     std::cout << text;
   } else {
     stages::write_text_atomically(cmd.output, text);
     std::cout << "evaluated " << rows.size() << " pairs, wrote " << cmd.output << "\n";
   }
+  if (report) std::cout << "wrote report " << cmd.report << "\n";
 }
 
 void add_eval_command(CLI::App& app, EvalCommand& cmd) {
   CLI::App* sub = app.add_subcommand(
-      "eval", "Dense flow error (AAE, EPE, R1, R3) and time over pairs with ground truth");
+      "eval",
+      "Dense flow error (AAE, EPE, R1, R3, KITTI Fl) and time over pairs with ground truth");
   CLI::Option* dir =
       sub->add_option(
              "DIR", cmd.dir,
-             "Middlebury tree: DIR/<seq>/frame10.png, frame11.png, flow10.flo (gray/ preferred)")
+             "Middlebury (DIR/<seq>/frame10.png, frame11.png, flow10.flo), MPI-Sintel "
+             "(flow/ with clean/ or final/) or KITTI (image_0/ or image_2/ with flow_occ/) "
+             "tree; found by its layout")
           ->type_name("DIR");
-  CLI::Option* pair = sub->add_option("--pair", cmd.pairs, "an image pair and its .flo; repeatable")
-                          ->type_name("A B GT")
-                          ->type_size(3)
-                          ->allow_extra_args(false);
+  CLI::Option* pair =
+      sub->add_option("--pair", cmd.pairs,
+                      "an image pair and its ground truth (.flo, or KITTI 16-bit .png); repeatable")
+          ->type_name("A B GT")
+          ->type_size(3)
+          ->allow_extra_args(false);
   sub->add_option("--exclude-mask", cmd.exclude_masks,
                   "pixels not scored (non-zero) for each --pair, in the same order")
       ->type_name("IMAGE")
       ->needs(pair);
   dir->excludes(pair);
+  sub->add_option("--layout", cmd.layout, "layout of DIR (auto: found from its folders)")
+      ->type_name("LAYOUT")
+      ->check(CLI::IsMember({"auto", "middlebury", "sintel", "kitti"}))
+      ->capture_default_str()
+      ->needs(dir);
+  sub->add_option("--pass", cmd.pass, "Sintel rendering pass")
+      ->type_name("PASS")
+      ->check(CLI::IsMember({"clean", "final", "albedo"}))
+      ->capture_default_str()
+      ->needs(dir);
+  sub->add_option("--scene", cmd.scene,
+                  "only this scene of DIR (Sintel alley_1, Middlebury Venus, KITTI 000042)")
+      ->type_name("NAME")
+      ->needs(dir);
+  sub->add_option("--max-pairs", cmd.max_pairs,
+                  "at most N pairs of DIR, evenly spaced over the sorted list (0: all)")
+      ->type_name("N")
+      ->check(CLI::NonNegativeNumber)
+      ->needs(dir);
   sub->add_option("--format", cmd.format, "output format")
       ->type_name("FORMAT")
       ->check(CLI::IsMember({"table", "csv", "json"}))
       ->capture_default_str();
   sub->add_option("-o,--output", cmd.output, "write the results to FILE instead of stdout")
       ->type_name("FILE");
+  sub->add_option("--report", cmd.report,
+                  "also write a self-contained HTML report (frames, colour-coded flows, error "
+                  "maps, metrics per pair)")
+      ->type_name("HTML");
   add_lk_options(*sub, cmd.lk);
   sub->callback([&cmd] { run_eval(cmd); });
 }
@@ -350,6 +412,7 @@ int main(int argc, char** argv) {
   add_score_command(app, score_cmd);
   int exit_code = 0;
   add_video_commands(app, exit_code);
+  add_sweep_command(app);
 
   try {
     app.parse(argc, argv);

@@ -16,12 +16,8 @@
 namespace {
 
 using namespace roiflow;
+using test::read_text;
 namespace fs = std::filesystem;
-
-std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
 
 class AtomicWriteTest : public test::TempDirTest {
  protected:

@@ -25,60 +25,16 @@ namespace {
 
 namespace fs = std::filesystem;
 using namespace roiflow;
-
-struct CliResult {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-std::vector<std::string> split(const std::string& text, char separator) {
-  std::vector<std::string> parts;
-  std::istringstream in(text);
-  for (std::string part; std::getline(in, part, separator);)
-    parts.push_back(part);
-  return parts;
-}
-
-std::vector<std::string> lines_of(const std::string& text) {
-  return split(text, '\n');
-}
-
-// Appends ` 'arg'` to a shell command line.
-void append_quoted(std::string& command, const std::string& arg) {
-  command += " '";
-  for (char c : arg) {
-    if (c == '\'') {
-      command += "'\\''";
-    } else {
-      command += c;
-    }
-  }
-  command += '\'';
-}
+using test::CliResult;
+using test::lines_of;
+using test::read_text;
+using test::run_cli;
+using test::split;
 
 class CliTest : public test::TempDirTest {
  protected:
   CliResult run(const std::vector<std::string>& args) const {
-    std::string command;
-    append_quoted(command, ROIFLOW_CLI_PATH);
-    for (const std::string& arg : args)
-      append_quoted(command, arg);
-    command += " >";
-    append_quoted(command, path("stdout.txt"));
-    command += " 2>";
-    append_quoted(command, path("stderr.txt"));
-    const int status = std::system(command.c_str());
-    CliResult result;
-    result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    result.out = read_text(path("stdout.txt"));
-    result.err = read_text(path("stderr.txt"));
-    return result;
+    return run_cli(args, path("stdout.txt"), path("stderr.txt"));
   }
 
   struct FailureCase {

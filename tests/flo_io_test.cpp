@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <limits>
 #include <random>
 #include <string>
@@ -230,6 +231,30 @@ TEST_F(FloIoTest, WriteOntoADirectoryThrowsAndLeavesNoTemporary) {
                target.string());
   EXPECT_FALSE(fs::exists(target.string() + ".tmp"));
   EXPECT_TRUE(fs::is_directory(target));
+}
+
+TEST_F(FloIoTest, ParseFloDecodesTheSameBytesAsReadFlo) {
+  const std::string p = write_raw("mem.flo", kFloMagic, 4, 3, ramp(4 * 3 * 2));
+  std::ifstream in(p, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const cv::Mat from_memory = parse_flo(bytes, "mem");
+  const cv::Mat from_file = read_flo(p);
+  ASSERT_EQ(from_memory.size(), cv::Size(4, 3));
+  EXPECT_EQ(cv::norm(from_memory, from_file, cv::NORM_INF), 0.0);
+  EXPECT_FLOAT_EQ(from_memory.at<cv::Vec2f>(2, 3)[1], 0.25f * 23 - 3.f);
+}
+
+TEST_F(FloIoTest, ParseFloRejectsLikeReadFloNamingTheInput) {
+  expect_error([&] { parse_flo("", "empty input"); }, "empty input");
+  expect_error([&] { parse_flo("", "x"); }, "shorter than the 12-byte header");
+  expect_error([&] { parse_flo(std::string(12, '\0'), "zeros"); }, "magic");
+  std::string header(12, '\0');
+  const std::int32_t size[2] = {2, 2};
+  std::memcpy(header.data(), &kFloMagic, 4);
+  std::memcpy(header.data() + 4, size, 8);
+  expect_error([&] { parse_flo(header, "h"); }, "truncated");
+  expect_error([&] { parse_flo(header + std::string(33, '\0'), "h"); }, "trailing");
+  EXPECT_EQ(parse_flo(header + std::string(32, '\0'), "h").size(), cv::Size(2, 2));
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <numbers>
 #include <string>
@@ -126,6 +127,7 @@ TEST(Metrics, NoCountedPixelGivesZeros) {
   EXPECT_EQ(e.aae_deg, 0.0);
   EXPECT_EQ(e.r1, 0.0);
   EXPECT_EQ(e.r3, 0.0);
+  EXPECT_EQ(e.fl, 0.0);
 }
 
 TEST(Metrics, MatchesAStraightforwardReferenceOnAView) {
@@ -142,7 +144,7 @@ TEST(Metrics, MatchesAStraightforwardReferenceOnAView) {
   const cv::Mat gt = big_gt(roi);
 
   double angle = 0, epe = 0;
-  int n = 0, over1 = 0, over3 = 0;
+  int n = 0, over1 = 0, over3 = 0, outliers = 0;
   for (int y = 0; y < gt.rows; ++y) {
     for (int x = 0; x < gt.cols; ++x) {
       const cv::Vec2f g = gt.at<cv::Vec2f>(y, x);
@@ -154,6 +156,7 @@ TEST(Metrics, MatchesAStraightforwardReferenceOnAView) {
       epe += d;
       over1 += d > 1;
       over3 += d > 3;
+      outliers += d > 3 && d > 0.05 * cv::norm(cv::Vec2d(g));
       ++n;
     }
   }
@@ -163,6 +166,44 @@ TEST(Metrics, MatchesAStraightforwardReferenceOnAView) {
   EXPECT_NEAR(e.epe, epe / n, 1e-9);
   EXPECT_DOUBLE_EQ(e.r1, 100.0 * over1 / n);
   EXPECT_DOUBLE_EQ(e.r3, 100.0 * over3 / n);
+  EXPECT_DOUBLE_EQ(e.fl, 100.0 * outliers / n);
+}
+
+// KITTI's outlier: EPE > 3 px AND EPE > 5 % of the true magnitude; both bounds strict.
+TEST(Metrics, FlNeedsBothThreePixelsAndFivePercent) {
+  struct Case {
+    cv::Vec2f estimate, truth;
+    bool outlier;
+  };
+  const Case cases[] = {
+      {{104, 0}, {100, 0}, false},  // EPE 4 > 3 but only 4 % of 100
+      {{106, 0}, {100, 0}, true},   // EPE 6 > 3 and 6 %
+      {{105, 0}, {100, 0}, false},  // exactly 5 %: not over it
+      {{3, 0}, {0, 0}, false},      // EPE exactly 3
+      {{3.5f, 0}, {0, 0}, true},    // zero motion: any EPE over 3 is over 5 %
+      {{13.5f, 0}, {10, 0}, true},  // 3.5 > 3 and > 0.5
+      {{0, 0}, {80, 60}, true},     // EPE 100 against |100|: 100 %
+      {{84, 63}, {80, 60}, false},  // EPE 5 = exactly 5 % of 100
+  };
+  cv::Mat estimate(1, std::size(cases), CV_32FC2);
+  cv::Mat truth(1, std::size(cases), CV_32FC2);
+  int outliers = 0;
+  for (std::size_t i = 0; i < std::size(cases); ++i) {
+    estimate.at<cv::Vec2f>(0, static_cast<int>(i)) = cases[i].estimate;
+    truth.at<cv::Vec2f>(0, static_cast<int>(i)) = cases[i].truth;
+    const FlowErrors single = flow_errors(one_pixel(cases[i].estimate[0], cases[i].estimate[1]),
+                                          one_pixel(cases[i].truth[0], cases[i].truth[1]));
+    EXPECT_EQ(single.fl, cases[i].outlier ? 100.0 : 0.0) << "case " << i;
+    outliers += cases[i].outlier;
+  }
+  EXPECT_DOUBLE_EQ(flow_errors(estimate, truth).fl, 100.0 * outliers / std::size(cases));
+
+  // Excluded and unknown pixels are not in the denominator either.
+  cv::Mat exclude(1, std::size(cases), CV_8UC1, cv::Scalar(0));
+  exclude.at<uchar>(0, 0) = 1;                // a non-outlier
+  truth.at<cv::Vec2f>(0, 1) = {kUnknown, 0};  // an outlier
+  EXPECT_DOUBLE_EQ(flow_errors(estimate, truth, exclude).fl,
+                   100.0 * (outliers - 1) / (std::size(cases) - 2));
 }
 
 TEST(Metrics, NonFiniteEstimateAtACountedPixelThrows) {

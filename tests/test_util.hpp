@@ -2,14 +2,21 @@
 //
 //   EXPECT_NE(error_message([&] { read_flo(path); }).find(path), std::string::npos);
 //   class MyTest : public roiflow::test::TempDirTest {};   // path("out.flo") is in a fresh dir
+//   CliResult r = run_cli({"eval", dir}, path("stdout.txt"), path("stderr.txt"));
 #pragma once
 
 #include <gtest/gtest.h>
 #include <stdlib.h>
+#include <sys/wait.h>
 
+#include <cstdlib>
 #include <exception>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "flow/error.hpp"
 
@@ -42,5 +49,58 @@ class TempDirTest : public ::testing::Test {
 
   std::filesystem::path dir_;
 };
+
+inline std::string read_text(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+inline std::vector<std::string> split(const std::string& text, char separator) {
+  std::vector<std::string> parts;
+  std::istringstream in(text);
+  for (std::string part; std::getline(in, part, separator);)
+    parts.push_back(part);
+  return parts;
+}
+
+inline std::vector<std::string> lines_of(const std::string& text) {
+  return split(text, '\n');
+}
+
+struct CliResult {
+  int exit_code = -1;  // -1 when the process did not exit normally
+  std::string out;
+  std::string err;
+};
+
+#ifdef ROIFLOW_CLI_PATH
+// Runs the roiflow CLI with `args` through the shell (each argument quoted), its stdout and
+// stderr going to two files that are read back and removed.
+inline CliResult run_cli(const std::vector<std::string>& args, const std::string& out_path,
+                         const std::string& err_path) {
+  const auto append_quoted = [](std::string& command, const std::string& arg) {
+    command += " '";
+    for (char c : arg)
+      command += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    command += '\'';
+  };
+  std::string command;
+  append_quoted(command, ROIFLOW_CLI_PATH);
+  for (const std::string& arg : args)
+    append_quoted(command, arg);
+  command += " >";
+  append_quoted(command, out_path);
+  command += " 2>";
+  append_quoted(command, err_path);
+  const int status = std::system(command.c_str());
+  CliResult result;
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  result.out = read_text(out_path);
+  result.err = read_text(err_path);
+  std::filesystem::remove(out_path);
+  std::filesystem::remove(err_path);
+  return result;
+}
+#endif
 
 }  // namespace roiflow::test

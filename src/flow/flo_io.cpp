@@ -3,6 +3,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -34,6 +35,62 @@ std::string to_text(double value) {
 
 }  // namespace
 
+namespace {
+
+struct FloHeader {
+  std::int32_t width = 0;
+  std::int32_t height = 0;
+};
+
+// Checks the 12 header bytes against the total size, before anything is allocated, so a corrupt
+// header cannot ask for gigabytes.
+FloHeader check_header(const char* header, std::uintmax_t total_bytes, const std::string& name) {
+  if (total_bytes < static_cast<std::uintmax_t>(kHeaderBytes)) {
+    fail(name, std::to_string(total_bytes) + " bytes, shorter than the 12-byte header");
+  }
+  float magic = 0;
+  FloHeader h;
+  std::memcpy(&magic, header, sizeof magic);
+  std::memcpy(&h.width, header + 4, sizeof h.width);
+  std::memcpy(&h.height, header + 8, sizeof h.height);
+  if (magic != kFloMagic) fail(name, "bad magic " + to_text(magic) + " (expected 202021.25)");
+  if (h.width <= 0 || h.height <= 0 || h.width > kMaxSide || h.height > kMaxSide) {
+    fail(name, "bad size " + std::to_string(h.width) + "x" + std::to_string(h.height));
+  }
+  const std::int64_t expected = kHeaderBytes + std::int64_t{8} * h.width * h.height;
+  if (total_bytes != static_cast<std::uintmax_t>(expected)) {
+    fail(name, std::to_string(h.width) + "x" + std::to_string(h.height) + " flow needs " +
+                   std::to_string(expected) + " bytes, file has " + std::to_string(total_bytes) +
+                   (total_bytes < static_cast<std::uintmax_t>(expected) ? " (truncated)"
+                                                                        : " (trailing bytes)"));
+  }
+  return h;
+}
+
+void check_no_nan(const cv::Mat& flow, const std::string& name) {
+  for (int y = 0; y < flow.rows; ++y) {
+    const float* row = flow.ptr<float>(y);
+    for (int i = 0; i < 2 * flow.cols; ++i) {
+      if (std::isnan(row[i])) {
+        fail(name, "NaN at (" + std::to_string(i / 2) + "," + std::to_string(y) + ")");
+      }
+    }
+  }
+}
+
+}  // namespace
+
+cv::Mat parse_flo(std::string_view bytes, const std::string& name) {
+  if (bytes.size() < static_cast<std::size_t>(kHeaderBytes)) {
+    check_header(nullptr, bytes.size(), name);  // throws "shorter than the header"
+  }
+  const FloHeader h = check_header(bytes.data(), bytes.size(), name);
+  cv::Mat flow(h.height, h.width, CV_32FC2);
+  std::memcpy(flow.data, bytes.data() + kHeaderBytes, bytes.size() - kHeaderBytes);
+  check_no_nan(flow, name);
+  return flow;
+}
+
 cv::Mat read_flo(const std::string& path) {
   namespace fs = std::filesystem;
   std::error_code ec;
@@ -43,44 +100,21 @@ cv::Mat read_flo(const std::string& path) {
   if (!fs::is_regular_file(status)) fail(path, "not a regular file");
   const std::uintmax_t file_bytes = fs::file_size(path, ec);
   if (ec) fail(path, "cannot get size: " + ec.message());
-
   if (file_bytes < static_cast<std::uintmax_t>(kHeaderBytes)) {
-    fail(path, std::to_string(file_bytes) + " bytes, shorter than the 12-byte header");
+    check_header(nullptr, file_bytes, path);  // throws "shorter than the header"
   }
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(path, "cannot open for reading");
 
-  float magic = 0;
-  std::int32_t width = 0;
-  std::int32_t height = 0;
-  in.read(reinterpret_cast<char*>(&magic), sizeof magic);
-  in.read(reinterpret_cast<char*>(&width), sizeof width);
-  in.read(reinterpret_cast<char*>(&height), sizeof height);
-  if (!in) fail(path, "cannot read the header");
-  if (magic != kFloMagic) fail(path, "bad magic " + to_text(magic) + " (expected 202021.25)");
-  if (width <= 0 || height <= 0 || width > kMaxSide || height > kMaxSide) {
-    fail(path, "bad size " + std::to_string(width) + "x" + std::to_string(height));
-  }
-  // Checked before allocating, so a corrupt header cannot ask for gigabytes.
-  const std::int64_t expected = kHeaderBytes + std::int64_t{8} * width * height;
-  if (static_cast<std::int64_t>(file_bytes) != expected) {
-    fail(path, std::to_string(width) + "x" + std::to_string(height) + " flow needs " +
-                   std::to_string(expected) + " bytes, file has " + std::to_string(file_bytes) +
-                   (static_cast<std::int64_t>(file_bytes) < expected ? " (truncated)"
-                                                                     : " (trailing bytes)"));
-  }
+  char header[kHeaderBytes];
+  if (!in.read(header, sizeof header)) fail(path, "cannot read the header");
+  const FloHeader h = check_header(header, file_bytes, path);
 
-  cv::Mat flow(height, width, CV_32FC2);
-  in.read(reinterpret_cast<char*>(flow.data), expected - kHeaderBytes);
-  if (in.gcount() != expected - kHeaderBytes) fail(path, "truncated while reading");
-  for (int y = 0; y < height; ++y) {
-    const float* row = flow.ptr<float>(y);
-    for (int i = 0; i < 2 * width; ++i) {
-      if (std::isnan(row[i])) {
-        fail(path, "NaN at (" + std::to_string(i / 2) + "," + std::to_string(y) + ")");
-      }
-    }
-  }
+  cv::Mat flow(h.height, h.width, CV_32FC2);
+  const std::streamsize body = static_cast<std::streamsize>(file_bytes) - kHeaderBytes;
+  in.read(reinterpret_cast<char*>(flow.data), body);
+  if (in.gcount() != body) fail(path, "truncated while reading");
+  check_no_nan(flow, path);
   return flow;
 }
 

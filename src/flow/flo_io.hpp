@@ -12,6 +12,7 @@
 
 #include <opencv2/core.hpp>
 #include <string>
+#include <string_view>
 
 namespace roiflow::flow {
 
@@ -19,6 +20,9 @@ inline constexpr float kFloMagic = 202021.25f;
 inline constexpr float kUnknownFlowThreshold = 1e9f;
 
 cv::Mat read_flo(const std::string& path);
+// The same format decoded from memory (the whole file's bytes); `name` is what error messages
+// call it. Same checks and errors as read_flo.
+cv::Mat parse_flo(std::string_view bytes, const std::string& name);
 // Writes atomically (temporary file + rename), so a failure never leaves a half file.
 void write_flo(const std::string& path, const cv::Mat& flow);
 

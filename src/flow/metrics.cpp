@@ -51,6 +51,7 @@ FlowErrors flow_errors(const cv::Mat& estimate, const cv::Mat& ground_truth,
   long long pixels = 0;
   long long over1 = 0;
   long long over3 = 0;
+  long long outliers = 0;
   for (int y = 0; y < estimate.rows; ++y) {
     const float* est = estimate.ptr<float>(y);
     const float* gt = ground_truth.ptr<float>(y);
@@ -71,6 +72,7 @@ FlowErrors flow_errors(const cv::Mat& estimate, const cv::Mat& ground_truth,
       sum_epe += epe;
       over1 += epe > 1;
       over3 += epe > 3;
+      outliers += epe > 3 && epe > 0.05 * std::sqrt(ug * ug + vg * vg);
       ++pixels;
     }
   }
@@ -83,6 +85,7 @@ FlowErrors flow_errors(const cv::Mat& estimate, const cv::Mat& ground_truth,
   e.epe = sum_epe / n;
   e.r1 = 100.0 * static_cast<double>(over1) / n;
   e.r3 = 100.0 * static_cast<double>(over3) / n;
+  e.fl = 100.0 * static_cast<double>(outliers) / n;
   return e;
 }
 

@@ -6,7 +6,8 @@
 // Over known ground-truth pixels only (|u| or |v| > 1e9, or NaN, is unknown) and, when
 // `exclude` is given (CV_8UC1, same size), outside its non-zero pixels.
 //   EPE = |(u, v) - (ug, vg)|;  AE = angle between (u, v, 1) and (ug, vg, 1) in degrees;
-//   R1, R3 = percentage of pixels with EPE > 1 and > 3.
+//   R1, R3 = percentage of pixels with EPE > 1 and > 3;
+//   Fl = percentage of pixels with EPE > 3 and EPE > 5 % of |(ug, vg)| (KITTI's outlier rate).
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -18,6 +19,7 @@ struct FlowErrors {
   double epe = 0;        // mean endpoint error, pixels
   double r1 = 0;         // % of pixels with EPE > 1
   double r3 = 0;         // % of pixels with EPE > 3
+  double fl = 0;         // % of pixels with EPE > 3 and EPE > 0.05 |ground truth| (KITTI Fl)
   long long pixels = 0;  // pixels counted
 };
 

@@ -1,7 +1,7 @@
-// A value quoted for an error message, cut to 40 characters: a binary file read as text must
-// not produce a screenful.
+// Text made safe for the places it is shown: an error message, HTML or SVG.
 //
 //   throw Error(path + ":" + std::to_string(line) + ": bad number " + quoted_excerpt(field));
+//   svg += "<text>" + escape_markup(label) + "</text>";
 #pragma once
 
 #include <cstddef>
@@ -10,12 +10,43 @@
 
 namespace roiflow::stages {
 
+// A value quoted for an error message, cut to 40 characters: a binary file read as text must
+// not produce a screenful.
 inline std::string quoted_excerpt(std::string_view text) {
   constexpr std::size_t kMax = 40;
   std::string shown(1, '\'');
   shown.append(text.substr(0, kMax));
   shown.append(text.size() > kMax ? "...'" : "'");
   return shown;
+}
+
+// Text for HTML or XML (SVG) content and attribute values: the five special characters as
+// entities, control characters other than tab dropped (XML 1.0 does not allow them).
+inline std::string escape_markup(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (char c : text) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&#39;";
+        break;
+      default:
+        if (static_cast<unsigned char>(c) >= 0x20 || c == '\t') out += c;
+    }
+  }
+  return out;
 }
 
 }  // namespace roiflow::stages
