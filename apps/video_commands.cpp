@@ -1,10 +1,20 @@
 // roiflow track, dense and demo: the video subcommands, each a run of the tbb::flow graph.
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
 #include <CLI/CLI.hpp>
+
+#include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <csignal>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
@@ -20,6 +30,7 @@
 #include "stages/annotate.hpp"
 #include "stages/atomic_write.hpp"
 #include "stages/otb_score.hpp"
+#include "stages/plot.hpp"
 #include "stages/progress.hpp"
 #include "stages/run_stats.hpp"
 #include "stages/track_log.hpp"
@@ -89,6 +100,19 @@ cv::Rect2f parse_box(const std::string& text, const std::string& option) {
           static_cast<float>(v[3])};
 }
 
+// The tracker's own criterion, checked before the run: at least 2x2 pixels of the --init box
+// (given as `text`) inside the first frame.
+void check_init_inside(const stages::TrackerParams& params, const std::string& text,
+                       cv::Size size) {
+  if (!params.init) return;
+  const cv::Rect2f inside = *params.init & cv::Rect2f(0.f, 0.f, static_cast<float>(size.width),
+                                                      static_cast<float>(size.height));
+  if (inside.width < 2.f || inside.height < 2.f) {
+    throw UsageError("--init: the box " + text + " lies outside the " + size_string(size) +
+                     " frame (less than 2x2 pixels of it inside)");
+  }
+}
+
 void check_log_path(const std::string& path) {
   check_output_path(path, "--log");
   std::string ext = fs::path(path).extension().string();
@@ -155,6 +179,9 @@ struct TrackCommand {
   long long start = 0;
   long long max_frames = 0;
   int in_flight = 0;
+  bool compare = false;  // --compare: local and global mode side by side
+  std::string compare_out = "out/compare";
+  std::vector<int> compare_patches;
 };
 
 struct TrackRun {
@@ -219,6 +246,7 @@ TrackRun track(const pipeline::FrameSource& source, cv::Size size, double fps, l
       {"threads", threads},
       {"roi", params.roi},
       {"max_in_flight", run.report.max_in_flight},
+      {"peak_rss_mb", stages::peak_rss_mb()},
       {"stages", s.at("stages")}};
   return run;
 }
@@ -256,7 +284,397 @@ void print_track_summary(const std::string& what, const nlohmann::ordered_json& 
   }
 }
 
+// ---------------------------------------------------------------------------------------------
+// roiflow track --compare: the same input in local and in global mode (paper Sec. 4.4-4.5,
+// Fig. 12). Each mode runs in a child process of this binary, one after the other, so that
+// each has the machine to itself and its peak memory is its own.
+
+// Thrown when a signal stopped a child run: the comparison is abandoned.
+struct CompareInterrupted {
+  int signal = 0;
+};
+
+// One child run, summarised from its --summary and the ms column of its --log.
+struct CompareRun {
+  std::string mode;
+  int patch = 0;
+  nlohmann::json summary;
+  std::vector<double> ms;  // tracker time of every frame
+  double ms_median = 0, ms_p95 = 0, ms_mean = 0;
+};
+
+// Linear interpolation between order statistics; `sorted` is not empty.
+double percentile(const std::vector<double>& sorted, double p) {
+  const double at = p * static_cast<double>(sorted.size() - 1);
+  const std::size_t i = static_cast<std::size_t>(at);
+  if (i + 1 >= sorted.size()) return sorted.back();
+  return sorted[i] + (at - static_cast<double>(i)) * (sorted[i + 1] - sorted[i]);
+}
+
+std::string exact(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.17g", v);
+  return buffer;
+}
+
+// The command line of one child: everything the user gave that changes the run, the mode, the
+// patch, and the child's log and summary.
+std::vector<std::string> child_args(const TrackCommand& cmd, const std::string& mode, int patch,
+                                    const std::string& log, const std::string& summary) {
+  std::vector<std::string> a = {"roiflow",
+                                "track",
+                                cmd.input,
+                                "--mode",
+                                mode,
+                                "--roi",
+                                std::to_string(cmd.roi),
+                                "--log",
+                                log,
+                                "--summary",
+                                summary,
+                                "--no-progress",
+                                "--start",
+                                std::to_string(cmd.start),
+                                "--max-frames",
+                                std::to_string(cmd.max_frames),
+                                "--in-flight",
+                                std::to_string(cmd.in_flight),
+                                "--preset",
+                                cmd.lk.preset,
+                                "--patch",
+                                std::to_string(patch),
+                                "--threads",
+                                std::to_string(cmd.lk.threads)};
+  if (!cmd.init.empty()) a.insert(a.end(), {"--init", cmd.init});
+  const LkOptions& lk = cmd.lk;
+  if (lk.levels) a.insert(a.end(), {"--levels", std::to_string(*lk.levels)});
+  if (lk.iterations) a.insert(a.end(), {"--iterations", std::to_string(*lk.iterations)});
+  if (lk.level_median) a.insert(a.end(), {"--level-median", std::to_string(*lk.level_median)});
+  if (lk.final_median) a.insert(a.end(), {"--final-median", std::to_string(*lk.final_median)});
+  if (lk.sigma) a.insert(a.end(), {"--sigma", exact(*lk.sigma)});
+  if (lk.lambda) a.insert(a.end(), {"--lambda", exact(*lk.lambda)});
+  if (lk.robust_scale) a.insert(a.end(), {"--robust-scale", exact(*lk.robust_scale)});
+  if (lk.derivative) a.insert(a.end(), {"--derivative", *lk.derivative});
+  return a;
+}
+
+// Runs this binary with `args` (stdout discarded, stderr to `err_path`) and waits for it. A
+// signal that reaches this process is passed on to the child, which then ends its run the way
+// track does. Returns the exit code, 128 + the signal when the child was killed.
+int run_child(const std::vector<std::string>& args, const std::string& err_path) {
+  // The running binary itself, even when a rebuild has since replaced the file on disk.
+  const fs::path exe = "/proc/self/exe";
+  std::vector<char*> argv;
+  for (const std::string& arg : args)
+    argv.push_back(const_cast<char*>(arg.c_str()));
+  argv.push_back(nullptr);
+
+  posix_spawn_file_actions_t files;
+  posix_spawn_file_actions_init(&files);
+  posix_spawn_file_actions_addopen(&files, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&files, STDERR_FILENO, err_path.c_str(),
+                                   O_WRONLY | O_CREAT | O_TRUNC, 0600);
+  pid_t pid = 0;
+  const int rc = posix_spawn(&pid, exe.c_str(), &files, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&files);
+  if (rc != 0) {
+    throw Error("--compare: cannot start '" + exe.string() + "': " + std::strerror(rc));
+  }
+  bool forwarded = false;
+  int status = 0;
+  for (;;) {
+    const pid_t done = waitpid(pid, &status, WNOHANG);
+    if (done == pid) break;
+    if (done < 0 && errno != EINTR) {
+      throw Error(std::string("--compare: waiting for the child run failed: ") +
+                  std::strerror(errno));
+    }
+    if (!forwarded && g_signal.load() != 0) {
+      kill(pid, g_signal.load());
+      forwarded = true;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  if (WIFEXITED(status)) return WEXITSTATUS(status);
+  return WIFSIGNALED(status) ? 128 + WTERMSIG(status) : 1;
+}
+
+// The child's own error line, without its "roiflow: error: " prefix.
+std::string child_error(const std::string& err_path) {
+  std::ifstream in(err_path);
+  std::string line, last;
+  while (std::getline(in, line)) {
+    if (!line.empty()) last = line;
+  }
+  const std::string prefix = "roiflow: error: ";
+  if (last.rfind(prefix, 0) == 0) last = last.substr(prefix.size());
+  return last;
+}
+
+CompareRun compare_run(const TrackCommand& cmd, const std::string& mode, int patch,
+                       const fs::path& log_dir, const fs::path& temp_dir, const std::string& stem) {
+  const std::string log = (log_dir / (stem + ".csv")).string();
+  const std::string summary = (log_dir / (stem + ".json")).string();
+  const std::string err = (temp_dir / (stem + ".err")).string();
+  if (stages::Progress::stderr_is_terminal() && cmd.out.progress) {
+    std::cerr << "compare: " << mode << " mode, patch " << patch << " ..." << std::endl;
+  }
+  const int code = run_child(child_args(cmd, mode, patch, log, summary), err);
+  if (code != 0) {
+    if (g_signal.load() != 0) throw CompareInterrupted{g_signal.load()};
+    const std::string why = child_error(err);
+    throw Error("--compare: the " + mode + " run (patch " + std::to_string(patch) +
+                ") failed with exit code " + std::to_string(code) +
+                (why.empty() ? std::string() : ": " + why));
+  }
+  CompareRun run;
+  run.mode = mode;
+  run.patch = patch;
+  std::ifstream in(summary);
+  try {
+    run.summary = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw Error("--compare: cannot read the " + mode + " run's summary '" + summary +
+                "': " + e.what());
+  }
+  for (const stages::TrackRecord& r : stages::read_track_csv(log))
+    run.ms.push_back(r.ms);
+  if (run.ms.empty()) throw Error("--compare: the " + mode + " run tracked no frame");
+  std::vector<double> sorted = run.ms;
+  std::sort(sorted.begin(), sorted.end());
+  run.ms_median = percentile(sorted, 0.5);
+  run.ms_p95 = percentile(sorted, 0.95);
+  for (double v : sorted)
+    run.ms_mean += v;
+  run.ms_mean /= static_cast<double>(sorted.size());
+  return run;
+}
+
+double summary_number(const CompareRun& run, const char* key) {
+  const auto it = run.summary.find(key);
+  if (it == run.summary.end() || !it->is_number()) {
+    throw Error("--compare: the " + run.mode + " run's summary has no number '" + key + "'");
+  }
+  return it->get<double>();
+}
+
+nlohmann::ordered_json compare_json(const CompareRun& r) {
+  return {{"mode", r.mode},
+          {"patch", r.patch},
+          {"frames", summary_number(r, "frames")},
+          {"fps", summary_number(r, "fps")},
+          {"tracker_fps", summary_number(r, "tracker_fps")},
+          {"ms_median", r.ms_median},
+          {"ms_p95", r.ms_p95},
+          {"ms_mean", r.ms_mean},
+          {"global_activations", summary_number(r, "global_activations")},
+          {"peak_rss_mb", summary_number(r, "peak_rss_mb")}};
+}
+
+std::string compare_csv_row(const CompareRun& r) {
+  return std::to_string(r.patch) + "," + r.mode + "," +
+         std::to_string(std::llround(summary_number(r, "frames"))) + "," +
+         fixed(summary_number(r, "fps"), 2) + "," + fixed(summary_number(r, "tracker_fps"), 2) +
+         "," + fixed(r.ms_median, 3) + "," + fixed(r.ms_p95, 3) + "," + fixed(r.ms_mean, 3) + "," +
+         std::to_string(std::llround(summary_number(r, "global_activations"))) + "," +
+         fixed(summary_number(r, "peak_rss_mb"), 1) + "\n";
+}
+
+// ms per frame (median) of global over local: how many times faster local mode is.
+double speedup(const CompareRun& local, const CompareRun& global) {
+  return local.ms_median > 0 ? global.ms_median / local.ms_median : 0.0;
+}
+
+int run_compare(const TrackCommand& cmd) {
+  const stages::TrackerParams params = tracker_params(cmd);
+  const bool camera =
+      !cmd.input.empty() && std::all_of(cmd.input.begin(), cmd.input.end(),
+                                        [](unsigned char c) { return std::isdigit(c); });
+  if (camera) {
+    throw UsageError("--compare needs a video file or an image folder: a camera (" + cmd.input +
+                     ") would show each mode different frames");
+  }
+  {
+    // Opened here only to check the input and --init before any child starts.
+    stages::VideoSourceParams source_params;
+    source_params.start = cmd.start;
+    source_params.max_frames = cmd.max_frames;
+    stages::VideoSource source(cmd.input, source_params);
+    if (params.init) {
+      const cv::Rect2f frame(0.f, 0.f, static_cast<float>(source.size().width),
+                             static_cast<float>(source.size().height));
+      if ((*params.init & frame).area() <= 0.f) {
+        throw UsageError("--init: the box " + cmd.init + " lies outside the " +
+                         size_string(source.size()) + " frame");
+      }
+    }
+  }
+  std::error_code ec;
+  if (fs::exists(cmd.compare_out, ec) && !fs::is_directory(cmd.compare_out, ec)) {
+    throw Error("--compare-out: '" + cmd.compare_out + "' exists and is not a directory");
+  }
+  fs::create_directories(cmd.compare_out, ec);
+  if (ec) throw Error("--compare-out: cannot create '" + cmd.compare_out + "': " + ec.message());
+  const fs::path out_dir = cmd.compare_out;
+  std::string temp = (out_dir / ".runs-XXXXXX").string();
+  if (mkdtemp(temp.data()) == nullptr) {
+    throw Error("--compare-out: cannot create a folder in '" + cmd.compare_out + "'");
+  }
+  struct RemoveDir {
+    fs::path dir;
+    ~RemoveDir() {
+      std::error_code ignored;
+      fs::remove_all(dir, ignored);
+    }
+  } remove_temp{temp};
+
+  SignalScope signals;
+  const int patch = params.lk.patch;
+  std::vector<CompareRun> main_runs;
+  std::vector<std::pair<CompareRun, CompareRun>> patch_runs;
+  try {
+    for (const char* mode : {"local", "global"})
+      main_runs.push_back(compare_run(cmd, mode, patch, out_dir, temp, mode));
+    for (int p : cmd.compare_patches) {
+      if (p == patch) {
+        patch_runs.emplace_back(main_runs[0], main_runs[1]);
+        continue;
+      }
+      const std::string stem = "patch" + std::to_string(p) + "_";
+      patch_runs.emplace_back(compare_run(cmd, "local", p, temp, temp, stem + "local"),
+                              compare_run(cmd, "global", p, temp, temp, stem + "global"));
+    }
+  } catch (const CompareInterrupted& stop) {
+    std::cerr << "roiflow: error: interrupted by " << (stop.signal == SIGINT ? "SIGINT" : "SIGTERM")
+              << " during the compare runs; no comparison written\n";
+    return 128 + stop.signal;
+  }
+  const CompareRun& local = main_runs[0];
+  const CompareRun& global = main_runs[1];
+
+  // Files: compare.csv, compare.json, ms_per_frame.svg, patches.svg (with --compare-patches).
+  std::string csv =
+      "patch,mode,frames,fps,tracker_fps,ms_median,ms_p95,ms_mean,global_activations,"
+      "peak_rss_mb\n";
+  nlohmann::ordered_json doc;
+  doc["input"] = cmd.input;
+  doc["threads"] = cmd.lk.threads;
+  doc["preset"] = cmd.lk.preset;
+  doc["patch"] = patch;
+  doc["local"] = compare_json(local);
+  doc["global"] = compare_json(global);
+  doc["speedup_median_ms"] = speedup(local, global);
+  const double local_fps = summary_number(local, "tracker_fps");
+  const double global_fps = summary_number(global, "tracker_fps");
+  doc["speedup_tracker_fps"] = global_fps > 0 ? local_fps / global_fps : 0.0;
+  csv += compare_csv_row(local) + compare_csv_row(global);
+  doc["patches"] = nlohmann::ordered_json::array();
+  for (const auto& [l, g] : patch_runs) {
+    doc["patches"].push_back({{"patch", l.patch},
+                              {"local", compare_json(l)},
+                              {"global", compare_json(g)},
+                              {"speedup_median_ms", speedup(l, g)}});
+    csv += compare_csv_row(l) + compare_csv_row(g);
+  }
+  std::vector<std::string> written;
+  const auto write_text = [&](const std::string& name, const std::string& text) {
+    const std::string path = (out_dir / name).string();
+    stages::write_text_atomically(path, text);
+    written.push_back(path);
+  };
+  write_text("compare.csv", csv);
+  write_text("compare.json", doc.dump(2) + "\n");
+
+  stages::Plot frames_plot;
+  frames_plot.title = "Tracker time per frame, local vs global (" +
+                      fs::path(cmd.input).filename().string() + ", patch " + std::to_string(patch) +
+                      ")";
+  frames_plot.x_label = "frame index";
+  stages::PlotPanel& frames_panel = frames_plot.panels.emplace_back();
+  frames_panel.y_label = "tracker time (ms per frame)";
+  frames_panel.y_from_zero = true;
+  for (const CompareRun* r : {&local, &global}) {
+    stages::PlotSeries s;
+    s.name = r->mode + " (median " + fixed(r->ms_median, 2) + " ms)";
+    for (std::size_t i = 0; i < r->ms.size(); ++i) {
+      s.x.push_back(static_cast<double>(cmd.start + static_cast<long long>(i) + 1));
+      s.y.push_back(r->ms[i]);
+    }
+    s.markers = r->ms.size() <= 60;
+    frames_panel.series.push_back(std::move(s));
+  }
+  const std::string frames_svg = (out_dir / "ms_per_frame.svg").string();
+  stages::write_plot_svg(frames_svg, frames_plot);
+  written.push_back(frames_svg);
+
+  if (!patch_runs.empty()) {
+    stages::Plot plot;
+    plot.title = "Tracker time vs patch size, local vs global (" +
+                 fs::path(cmd.input).filename().string() + ")";
+    plot.x_label = "patch size (px)";
+    plot.panels.resize(2);  // references taken after the last resize stay valid
+    stages::PlotPanel& time = plot.panels[0];
+    time.y_label = "tracker time (ms per frame, median)";
+    time.y_from_zero = true;
+    stages::PlotPanel& ratio = plot.panels[1];
+    ratio.y_label = "global / local time (x)";
+    ratio.y_from_zero = true;
+    stages::PlotSeries l{"local", {}, {}}, g{"global", {}, {}}, r{"speed-up of local", {}, {}};
+    for (const auto& [lr, gr] : patch_runs) {
+      l.x.push_back(lr.patch);
+      l.y.push_back(lr.ms_median);
+      g.x.push_back(gr.patch);
+      g.y.push_back(gr.ms_median);
+      r.x.push_back(lr.patch);
+      r.y.push_back(speedup(lr, gr));
+    }
+    time.series = {l, g};
+    ratio.series = {r};
+    const std::string path = (out_dir / "patches.svg").string();
+    stages::write_plot_svg(path, plot);
+    written.push_back(path);
+  }
+
+  // The table.
+  std::cout << "compare " << cmd.input << ": local vs global, patch " << patch << ", "
+            << cmd.lk.threads << " threads, one mode after the other\n";
+  char line[256];
+  std::snprintf(line, sizeof line, "%-7s %7s %8s %12s %10s %8s %8s %12s %9s\n", "mode", "frames",
+                "fps", "tracker fps", "ms median", "ms p95", "ms mean", "global act.", "peak MiB");
+  std::cout << line;
+  const auto print_row = [&](const CompareRun& r) {
+    std::snprintf(line, sizeof line, "%-7s %7lld %8.1f %12.1f %10.3f %8.3f %8.3f %12lld %9.1f\n",
+                  r.mode.c_str(), std::llround(summary_number(r, "frames")),
+                  summary_number(r, "fps"), summary_number(r, "tracker_fps"), r.ms_median, r.ms_p95,
+                  r.ms_mean, std::llround(summary_number(r, "global_activations")),
+                  summary_number(r, "peak_rss_mb"));
+    std::cout << line;
+  };
+  print_row(local);
+  print_row(global);
+  std::cout << "local mode is " << fixed(speedup(local, global), 1)
+            << "x faster than global (median ms per frame), "
+            << fixed(doc["speedup_tracker_fps"].get<double>(), 1) << "x (tracker fps)\n";
+  if (!patch_runs.empty()) {
+    std::snprintf(line, sizeof line, "%6s %16s %16s %9s\n", "patch", "local ms median",
+                  "global ms median", "speed-up");
+    std::cout << line;
+    for (const auto& [lr, gr] : patch_runs) {
+      std::snprintf(line, sizeof line, "%6d %16.3f %16.3f %8.1fx\n", lr.patch, lr.ms_median,
+                    gr.ms_median, speedup(lr, gr));
+      std::cout << line;
+    }
+  }
+  std::string list;
+  for (const std::string& w : written)
+    list += (list.empty() ? "" : ", ") + w;
+  std::cout << "  wrote " << list << "\n  per-mode logs and summaries: "
+            << (out_dir / "{local,global}.{csv,json}").string() << "\n";
+  return 0;
+}
+
 int run_track(const TrackCommand& cmd) {
+  if (cmd.compare) return run_compare(cmd);
   const stages::TrackerParams params = tracker_params(cmd);
   if (!cmd.log.empty()) check_log_path(cmd.log);
   if (!cmd.out.video.empty()) check_output_path(cmd.out.video, "--out");
@@ -266,14 +684,7 @@ int run_track(const TrackCommand& cmd) {
   source_params.start = cmd.start;
   source_params.max_frames = cmd.max_frames;
   stages::VideoSource source(cmd.input, source_params);
-  if (params.init) {
-    const cv::Rect2f frame(0.f, 0.f, static_cast<float>(source.size().width),
-                           static_cast<float>(source.size().height));
-    if ((*params.init & frame).area() <= 0.f) {
-      throw UsageError("--init: the box " + cmd.init + " lies outside the " +
-                       size_string(source.size()) + " frame");
-    }
-  }
+  check_init_inside(params, cmd.init, source.size());
 
   SignalScope signals;
   TrackRun run =
@@ -304,9 +715,9 @@ void add_run_outputs(CLI::App& sub, RunOutputs& out, const std::string& video_he
 
 void add_source_options(CLI::App& sub, long long& start, long long& max_frames, int& in_flight) {
   sub.add_option("--start", start, "index of the first frame to read")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0LL, std::numeric_limits<long long>::max()));
   sub.add_option("--max-frames", max_frames, "stop after this many frames (0 = all)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0LL, std::numeric_limits<long long>::max()));
   sub.add_option("--in-flight", in_flight,
                  "frames decoded ahead and in the pipeline at most (0 = 2 x threads + 2)")
       ->check(CLI::Range(0, 1024));
@@ -316,7 +727,8 @@ void add_track_command(CLI::App& app, TrackCommand& cmd, int& exit_code) {
   CLI::App* sub = app.add_subcommand(
       "track", "Track the moving object of a video with LK in a local region (paper's system)");
   sub->add_option("INPUT", cmd.input,
-                  "video file, image-sequence folder (OTB img/), or camera index")
+                  "video file, image-sequence folder (OTB img/), camera index, or "
+                  "synthetic:N[:WxH] (a generated stream of N frames, for soak runs)")
       ->required();
   sub->add_option("--init", cmd.init,
                   "the target's box in the first frame, x,y,w,h (OTB protocol); without it the "
@@ -336,6 +748,28 @@ void add_track_command(CLI::App& app, TrackCommand& cmd, int& exit_code) {
   add_source_options(*sub, cmd.start, cmd.max_frames, cmd.in_flight);
   cmd.lk.threads = default_threads();
   add_lk_options(*sub, cmd.lk);
+  const std::string group = "Run-time comparison (paper Sec. 4.4-4.5, Fig. 12)";
+  CLI::Option* compare =
+      sub->add_flag("--compare", cmd.compare,
+                    "run the input in local and in global mode (child processes, one after the "
+                    "other) and report fps, ms per frame, global activations and peak memory")
+          ->group(group);
+  for (const char* name : {"--mode", "--log", "--out", "--summary"})
+    compare->excludes(sub->get_option(name));
+  sub->add_option("--compare-out", cmd.compare_out,
+                  "folder for compare.csv/.json, ms_per_frame.svg, patches.svg and each mode's "
+                  "log and summary (created if missing)")
+      ->type_name("DIR")
+      ->capture_default_str()
+      ->needs(compare)
+      ->group(group);
+  sub->add_option("--compare-patches", cmd.compare_patches,
+                  "also compare at these patch sizes, e.g. 6,10,14,20 (Fig. 12's axis)")
+      ->type_name("LIST")
+      ->delimiter(',')
+      ->check(CLI::Range(3, 31))
+      ->needs(compare)
+      ->group(group);
   sub->callback([&cmd, &exit_code] { exit_code = run_track(cmd); });
 }
 
@@ -401,6 +835,7 @@ int run_dense(const DenseCommand& cmd) {
       {"threads", cmd.lk.threads},
       {"preset", cmd.lk.preset},
       {"status", end.message.empty() ? source.status().message : end.message},
+      {"peak_rss_mb", stages::peak_rss_mb()},
       {"stages", s.at("stages")}};
   std::string written = cmd.out.video;
   if (!cmd.out.summary.empty()) {

@@ -130,3 +130,15 @@ TEST(RunStats, BadValuesThrowNamingThem) {
 }
 
 }  // namespace
+
+TEST(PeakRss, GrowsWhenMemoryIsTouchedAndNeverFalls) {
+  const double before = stages::peak_rss_mb();
+  ASSERT_GT(before, 1.0);  // a running test binary holds more than 1 MiB
+  {
+    std::vector<unsigned char> block(96u << 20);
+    for (std::size_t i = 0; i < block.size(); i += 4096)
+      block[i] = static_cast<unsigned char>(i);
+    EXPECT_GE(stages::peak_rss_mb(), before + 64.0) << "touched 96 MiB";
+  }
+  EXPECT_GE(stages::peak_rss_mb(), before + 64.0) << "the peak is a high-water mark";
+}

@@ -1,5 +1,6 @@
 #include "stages/run_stats.hpp"
 
+#include <sys/resource.h>
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -33,6 +34,12 @@ std::string printf_text(const char* format, auto... args) {
 }
 
 }  // namespace
+
+double peak_rss_mb() {
+  rusage usage{};
+  if (getrusage(RUSAGE_SELF, &usage) != 0) return 0;
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // Linux reports KiB
+}
 
 void RunStats::add(std::string_view stage, double ms) {
   check_stage_name(stage);

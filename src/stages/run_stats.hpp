@@ -31,6 +31,10 @@
 
 namespace roiflow::stages {
 
+// The process's peak resident set size so far, in MiB (getrusage ru_maxrss); 0 where the
+// platform does not report it. Monotonic: a long run shows whether memory stays flat.
+double peak_rss_mb();
+
 class RunStats {
  public:
   void add(std::string_view stage, double ms);
