@@ -206,4 +206,40 @@ TEST_F(OtbScoreTest, TrackBoxesNeedFramesOneTwoThree) {
             std::string::npos);
 }
 
+TEST_F(OtbScoreTest, ParseGroundTruthReadsTextAndNamesItInErrors) {
+  const std::vector<cv::Rect2f> boxes = stages::parse_ground_truth("1,2,3,4\r\n\n5 6 7 8", "mem");
+  ASSERT_EQ(boxes.size(), 2u);
+  EXPECT_EQ(boxes[1], cv::Rect2f(5, 6, 7, 8));
+  EXPECT_NE(test::error_message([] {
+              stages::parse_ground_truth("1,2,3\n", "mem.txt");
+            }).find("mem.txt:1: expected 4 values"),
+            std::string::npos);
+  EXPECT_NE(test::error_message([] {
+              stages::parse_ground_truth(" \n\t\n", "blank");
+            }).find("holds no box"),
+            std::string::npos);
+}
+
+// Found by fuzzing (tests/fuzz_regressions/ground_truth): a double beyond the float range became
+// an infinite box.
+TEST_F(OtbScoreTest, GroundTruthValuesBeyondTheFloatRangeAreRejected) {
+  const std::string message =
+      test::error_message([] { stages::parse_ground_truth("1,2,1e39,4\n", "big.txt"); });
+  EXPECT_NE(message.find("big.txt:1: value 3 '1e39' is too large"), std::string::npos) << message;
+  EXPECT_EQ(stages::parse_ground_truth("3e38,0,1,1", "ok")[0].x, 3e38f);
+}
+
+// Found by fuzzing: far from the origin the box's right edge rounded up (x = 7e17, a double's
+// step there is 128) and the IoU of a box with itself came out as 1.49.
+TEST_F(OtbScoreTest, IouStaysExactFarFromTheOrigin) {
+  for (const float x : {7e17f, -7e17f, 1e30f, 3e38f}) {
+    const cv::Rect2f box(x, 51, 107, 87);
+    EXPECT_DOUBLE_EQ(iou(box, box), 1.0) << x;
+    EXPECT_DOUBLE_EQ(iou(box, cv::Rect2f(x, 51, 107, 43.5f)), 0.5) << x;
+  }
+  const std::vector<cv::Rect2f> far = {{7e17f, 51, 107, 87}, {42, 51, 107, 87}};
+  EXPECT_NEAR(stages::score(far, far).auc, 20.0 / 21.0, 1e-12);
+  EXPECT_DOUBLE_EQ(stages::score(far, far).mean_iou, 1.0);
+}
+
 }  // namespace

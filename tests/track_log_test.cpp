@@ -19,11 +19,7 @@ namespace {
 using namespace roiflow;
 using stages::TrackLogWriter;
 using stages::TrackRecord;
-
-std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using test::read_text;
 
 void write_text(const std::string& path, const std::string& text) {
   std::ofstream(path, std::ios::binary) << text;
@@ -219,6 +215,34 @@ TEST_F(TrackLogTest, ReaderErrorsNameFileLineAndValue) {
   const std::string missing = path("missing.csv");
   EXPECT_NE(test::error_message([&] { stages::read_track_csv(missing); }).find(missing),
             std::string::npos);
+}
+
+TEST_F(TrackLogTest, ParseTrackCsvReadsTextAndNamesItInErrors) {
+  write_all(path("t.csv"), sample_records());
+  const std::vector<TrackRecord> records = stages::parse_track_csv(read_text(path("t.csv")), "mem");
+  ASSERT_EQ(records.size(), 3u);
+  EXPECT_EQ(records[2].frame, 3);
+  EXPECT_TRUE(records[2].lost);
+  const std::string message =
+      test::error_message([] { stages::parse_track_csv("frame,x\n", "mem.csv"); });
+  EXPECT_NE(message.find("mem.csv:1: header"), std::string::npos) << message;
+  EXPECT_NE(test::error_message([] { stages::parse_track_csv("", "e"); }).find("e:1: empty file"),
+            std::string::npos);
+}
+
+// Found by fuzzing (tests/fuzz_regressions/track_csv): a double beyond the float range became an
+// infinite box or velocity.
+TEST_F(TrackLogTest, ValuesBeyondTheFloatRangeAreRejected) {
+  const std::string header = "frame,x,y,w,h,vx,vy,mode,lost,ms\n";
+  const std::string message = test::error_message(
+      [&] { stages::parse_track_csv(header + "1,0,0,1,1,0,-1e39,local,0,1\n", "big.csv"); });
+  EXPECT_NE(message.find("big.csv:2: vy '-1e39' is too large"), std::string::npos) << message;
+  EXPECT_NE(test::error_message([&] {
+              stages::parse_track_csv(header + "1,1e39,0,1,1,0,0,local,0,1\n", "x");
+            }).find("x '1e39' is too large"),
+            std::string::npos);
+  // ms is a double: a large one is fine.
+  EXPECT_EQ(stages::parse_track_csv(header + "1,0,0,1,1,0,0,local,0,1e39\n", "ok")[0].ms, 1e39);
 }
 
 }  // namespace

@@ -79,6 +79,13 @@ void expect_in_order(const std::vector<Frame>& frames, long long first, int n) {
   }
 }
 
+// Indices first..first+n-1, in order.
+void expect_indices(const std::vector<Frame>& frames, long long first, int n) {
+  ASSERT_EQ(static_cast<int>(frames.size()), n);
+  for (int i = 0; i < n; ++i)
+    EXPECT_EQ(frames[static_cast<std::size_t>(i)].index, first + i);
+}
+
 class VideoSourceTest : public roiflow::test::TempDirTest {
  protected:
   std::string write_video(const std::string& name = "clip.avi", int n = kFrames) {
@@ -280,6 +287,112 @@ TEST_F(VideoSourceTest, BadParamsThrowNamingTheValue) {
   EXPECT_NE(error_message([&] { VideoSource s(path("seq"), {.start = -1}); }).find("got -1"),
             std::string::npos);
   EXPECT_NE(error_message([&] { VideoSource s(path("seq"), {.max_frames = -2}); }).find("got -2"),
+            std::string::npos);
+}
+
+TEST_F(VideoSourceTest, SyntheticStreamDeliversExactlyNFramesInOrder) {
+  VideoSource source("synthetic:700:96x72", {.fps = 50});
+  EXPECT_EQ(source.size(), cv::Size(96, 72));
+  EXPECT_EQ(source.frame_count_hint(), 700);
+  EXPECT_DOUBLE_EQ(source.fps(), 50);
+  EXPECT_NE(source.description().find("synthetic scene (700 frames"), std::string::npos)
+      << source.description();
+  const std::vector<Frame> frames = read_all(source, 700);
+  ASSERT_EQ(frames.size(), 700u);
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    ASSERT_EQ(frames[i].index, static_cast<long long>(i));
+    EXPECT_DOUBLE_EQ(frames[i].timestamp_s, static_cast<double>(i) / 50);
+    EXPECT_EQ(frames[i].image.type(), CV_8UC3);
+    EXPECT_EQ(frames[i].gray.type(), CV_8UC1);
+  }
+  EXPECT_EQ(source.status().state, State::kEnded);
+  // The 300-frame scene plays forwards then backwards: frame 300 shows scene frame 298, frame
+  // 598 scene frame 0 again; neighbours differ (the vehicle moves, the noise changes).
+  const auto same = [&](std::size_t a, std::size_t b) {
+    return cv::norm(frames[a].image, frames[b].image, cv::NORM_INF) == 0;
+  };
+  EXPECT_TRUE(same(300, 298));
+  EXPECT_TRUE(same(598, 0));
+  EXPECT_TRUE(same(599, 1));
+  EXPECT_FALSE(same(1, 0));
+  EXPECT_FALSE(same(299, 298));
+}
+
+TEST_F(VideoSourceTest, SyntheticStreamHonoursStartAndMaxFrames) {
+  VideoSource source("synthetic:50:64x64", {.start = 10, .max_frames = 5});
+  EXPECT_EQ(source.frame_count_hint(), 5);
+  expect_indices(read_all(source), 10, 5);
+  VideoSource defaults("synthetic:3");
+  EXPECT_EQ(defaults.size(), cv::Size(640, 480));
+}
+
+TEST_F(VideoSourceTest, MalformedSyntheticInputThrowsNamingIt) {
+  for (const char* input :
+       {"synthetic:", "synthetic:0", "synthetic:-3", "synthetic:12x",
+        "synthetic:5:", "synthetic:5:640", "synthetic:5:32x32", "synthetic:5:9000x100",
+        "synthetic:5:640x480x2", "synthetic:2000000000"}) {
+    const std::string message = error_message([&] { VideoSource s(input); });
+    EXPECT_NE(message.find(std::string("bad synthetic input '") + input + "'"), std::string::npos)
+        << message;
+  }
+  // An existing file of that name is read as the file it is.
+  write_bytes(path("synthetic:5"), "not a video");
+  const std::string message = error_message([&] { VideoSource s(path("synthetic:5")); });
+  EXPECT_NE(message.find("cannot open video"), std::string::npos) << message;
+}
+
+TEST_F(VideoSourceTest, FrameSizeLimits) {
+  EXPECT_NO_THROW(check_frame_size({kMinFrameSide, kMinFrameSide}, "x"));
+  EXPECT_NO_THROW(check_frame_size({kMaxFrameSide, 4000}, "x"));  // 32.8 Mpixel
+  EXPECT_NO_THROW(check_frame_size({7680, 4320}, "x"));           // 8K UHD
+  const std::string tiny = error_message([] { check_frame_size({11, 500}, "image 'a.png'"); });
+  EXPECT_EQ(tiny, "image 'a.png' is 11x500: smaller than the minimum of 12 px a side");
+  EXPECT_NE(error_message([] {
+              check_frame_size({kMaxFrameSide + 1, 20}, "x");
+            }).find("8193x20"),
+            std::string::npos);
+  EXPECT_NE(error_message([] {
+              check_frame_size({8000, 6000}, "x");
+            }).find("40 Mpixel"),
+            std::string::npos);  // each side fits, the area does not
+
+  // A sequence whose first frame is out of range fails at construction, naming the size.
+  fs::create_directories(path("tiny"));
+  ASSERT_TRUE(cv::imwrite(path("tiny/1.png"), cv::Mat(1, 1, CV_8UC1, cv::Scalar(3))));
+  const std::string message = error_message([&] { VideoSource s(path("tiny")); });
+  EXPECT_NE(message.find("1x1: smaller than the minimum"), std::string::npos) << message;
+}
+
+TEST_F(VideoSourceTest, ReadImageRefusesCutOrDamagedPngAndJpeg) {
+  ASSERT_TRUE(cv::imwrite(path("a.png"), scene(1)));
+  ASSERT_TRUE(cv::imwrite(path("a.jpg"), scene(1)));
+  EXPECT_EQ(read_image(path("a.png"), cv::IMREAD_ANYCOLOR).size(), kSize);
+  EXPECT_EQ(read_image(path("a.jpg"), cv::IMREAD_GRAYSCALE).type(), CV_8UC1);
+  // Trailing bytes after the end of a JPEG (some cameras append data) are fine.
+  write_bytes(path("tail.jpg"), read_bytes(path("a.jpg")) + "trailer");
+  EXPECT_EQ(read_image(path("tail.jpg"), cv::IMREAD_ANYCOLOR).size(), kSize);
+
+  const std::string png = read_bytes(path("a.png"));
+  const std::string jpg = read_bytes(path("a.jpg"));
+  const struct {
+    std::string name, bytes, expected;
+  } cases[] = {
+      {"cut.png", png.substr(0, png.size() - 5), "truncated PNG"},
+      {"half.png", png.substr(0, png.size() / 2), "truncated PNG"},
+      {"chunk.png", png.substr(0, 12) + "\x01\x02\x03\x04" + png.substr(16), "damaged PNG"},
+      {"cut.jpg", jpg.substr(0, jpg.size() - 2), "truncated JPEG"},
+      {"half.jpg", jpg.substr(0, jpg.size() / 2), "truncated JPEG"},
+      {"empty.png", "", "empty file"},
+      {"text.png", "not an image", "cannot decode image"},
+  };
+  for (const auto& c : cases) {
+    write_bytes(path(c.name), c.bytes);
+    const std::string message =
+        error_message([&] { read_image(path(c.name), cv::IMREAD_ANYCOLOR); });
+    EXPECT_EQ(message.rfind("cannot decode image '" + path(c.name) + "'", 0), 0u) << message;
+    EXPECT_NE(message.find(c.expected), std::string::npos) << c.name << ": " << message;
+  }
+  EXPECT_NE(error_message([&] { read_image(path("none.png"), 0); }).find("cannot open image"),
             std::string::npos);
 }
 

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <sstream>
 #include <string_view>
 #include <system_error>
 
@@ -73,6 +74,11 @@ cv::Rect2f parse_box(std::string_view line, const std::string& where) {
       throw Error(where + "value " + std::to_string(k + 1) + " " + quoted_excerpt(t) +
                   " is not a finite number");
     }
+    // Boxes are floats: a larger value would become infinity (found by fuzzing).
+    if (std::abs(v[k]) > std::numeric_limits<float>::max()) {
+      throw Error(where + "value " + std::to_string(k + 1) + " " + quoted_excerpt(t) +
+                  " is too large");
+    }
     if (std::isnan(v[k])) ++nans;
   }
   if (nans != 0 && nans != 4) {
@@ -87,6 +93,23 @@ cv::Rect2f parse_box(std::string_view line, const std::string& where) {
 
 }  // namespace
 
+std::vector<cv::Rect2f> parse_ground_truth(std::string_view text, const std::string& name) {
+  std::vector<cv::Rect2f> boxes;
+  long long number = 0;
+  for (std::size_t start = 0; start < text.size();) {
+    ++number;
+    const std::size_t newline = text.find('\n', start);
+    const std::size_t end = newline == std::string_view::npos ? text.size() : newline;
+    std::string_view line = text.substr(start, end - start);
+    start = end + 1;
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    if (line.find_first_not_of(" \t") == std::string_view::npos) continue;
+    boxes.push_back(parse_box(line, name + ":" + std::to_string(number) + ": "));
+  }
+  if (boxes.empty()) throw Error("ground truth '" + name + "' holds no box");
+  return boxes;
+}
+
 std::vector<cv::Rect2f> read_ground_truth(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) {
@@ -94,17 +117,10 @@ std::vector<cv::Rect2f> read_ground_truth(const std::string& path) {
   }
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error("cannot open ground truth '" + path + "'");
-
-  std::vector<cv::Rect2f> boxes;
-  std::string line;
-  for (long long number = 1; std::getline(in, line); ++number) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.find_first_not_of(" \t") == std::string::npos) continue;
-    boxes.push_back(parse_box(line, path + ":" + std::to_string(number) + ": "));
-  }
-  if (in.bad()) throw Error("cannot read ground truth '" + path + "'");
-  if (boxes.empty()) throw Error("ground truth '" + path + "' holds no box");
-  return boxes;
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad() || text.bad()) throw Error("cannot read ground truth '" + path + "'");
+  return parse_ground_truth(text.str(), path);
 }
 
 std::vector<cv::Rect2f> track_boxes(const std::vector<TrackRecord>& records) {
@@ -124,13 +140,17 @@ std::vector<cv::Rect2f> track_boxes(const std::vector<TrackRecord>& records) {
 
 double iou(const cv::Rect2f& a, const cv::Rect2f& b) {
   if (!is_finite(a) || !is_finite(b) || !has_area(a) || !has_area(b)) return 0;
-  const double w =
-      std::min(double{a.x} + a.width, double{b.x} + b.width) - std::max(double{a.x}, double{b.x});
-  const double h =
-      std::min(double{a.y} + a.height, double{b.y} + b.height) - std::max(double{a.y}, double{b.y});
+  // Relative to a's corner, so that far from the origin (x = 7e17, where a double's step is
+  // 128) the sizes do not round away: the overlap never exceeds the smaller box and the IoU never
+  // exceeds 1 (found by fuzzing).
+  const double dx = double{b.x} - a.x;
+  const double dy = double{b.y} - a.y;
+  const double w = std::min(double{a.width}, dx + b.width) - std::max(0.0, dx);
+  const double h = std::min(double{a.height}, dy + b.height) - std::max(0.0, dy);
   if (w <= 0 || h <= 0) return 0;
-  const double inter = w * h;
-  return inter / (double{a.width} * a.height + double{b.width} * b.height - inter);
+  const double inter = std::min(w, double{std::min(a.width, b.width)}) *
+                       std::min(h, double{std::min(a.height, b.height)});
+  return std::min(1.0, inter / (double{a.width} * a.height + double{b.width} * b.height - inter));
 }
 
 double center_error(const cv::Rect2f& a, const cv::Rect2f& b) {

@@ -31,6 +31,7 @@
 
 #include <opencv2/core.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "stages/track_log.hpp"
@@ -47,9 +48,11 @@ struct OtbScore {
 // One box `x,y,w,h` per line, the values separated by commas, tabs or spaces (OTB files mix
 // them, and end lines with CRLF). Blank lines are skipped. A line of four NaN marks the target
 // absent and is kept, as NaN, so that line numbers stay frame numbers. Missing files, another
-// number of values, text that is not a number, infinities, a partly NaN line and a negative
-// size throw roiflow::Error as `path:line: what was wrong`.
+// number of values, text that is not a number, infinities, values beyond the float range, a partly
+// NaN line and a negative size throw roiflow::Error as `path:line: what was wrong`.
 std::vector<cv::Rect2f> read_ground_truth(const std::string& path);
+// The same from a file's text held in memory; `name` stands for the path in error messages.
+std::vector<cv::Rect2f> parse_ground_truth(std::string_view text, const std::string& name);
 
 // The boxes of a track log, box i being frame i + 1. Throws roiflow::Error naming the record
 // when frames are not numbered 1, 2, 3, ... in order (the pairing with ground truth would be

@@ -6,7 +6,9 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string_view>
 #include <system_error>
 
@@ -115,6 +117,15 @@ double parse_number(std::string_view field, const char* name, const LineError& e
   return value;
 }
 
+// Boxes and velocities are floats: a larger value would become infinity (found by fuzzing).
+float parse_float(std::string_view field, const char* name, const LineError& error) {
+  const double value = parse_number(field, name, error);
+  if (std::abs(value) > std::numeric_limits<float>::max()) {
+    error.fail(std::string(name) + " " + quoted_excerpt(field) + " is too large");
+  }
+  return static_cast<float>(value);
+}
+
 TrackRecord parse_row(std::string_view line, const LineError& error) {
   const std::vector<std::string_view> f = split_commas(line);
   if (f.size() != 10) {
@@ -126,15 +137,15 @@ TrackRecord parse_row(std::string_view line, const LineError& error) {
   if (ec != std::errc() || end != f[0].data() + f[0].size() || r.frame < 1) {
     error.fail("frame " + quoted_excerpt(f[0]) + " is not a frame number (1, 2, ...)");
   }
-  r.box.x = static_cast<float>(parse_number(f[1], "x", error));
-  r.box.y = static_cast<float>(parse_number(f[2], "y", error));
-  r.box.width = static_cast<float>(parse_number(f[3], "w", error));
-  r.box.height = static_cast<float>(parse_number(f[4], "h", error));
+  r.box.x = parse_float(f[1], "x", error);
+  r.box.y = parse_float(f[2], "y", error);
+  r.box.width = parse_float(f[3], "w", error);
+  r.box.height = parse_float(f[4], "h", error);
   if (r.box.width < 0 || r.box.height < 0) {
     error.fail("negative box size " + std::string(f[3]) + "x" + std::string(f[4]));
   }
-  r.velocity.x = static_cast<float>(parse_number(f[5], "vx", error));
-  r.velocity.y = static_cast<float>(parse_number(f[6], "vy", error));
+  r.velocity.x = parse_float(f[5], "vx", error);
+  r.velocity.y = parse_float(f[6], "vy", error);
   if (f[7] == "local") {
     r.mode = TrackRecord::Mode::Local;
   } else if (f[7] == "global") {
@@ -208,21 +219,17 @@ void TrackLogWriter::check_stream(const char* action) {
   if (out_.fail()) throw Error(std::string("cannot ") + action + " track log '" + path_ + "'");
 }
 
-std::vector<TrackRecord> read_track_csv(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    throw Error("cannot read track log '" + path + "': no such file");
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error("cannot open track log '" + path + "'");
-
+std::vector<TrackRecord> parse_track_csv(std::string_view text, const std::string& name) {
   std::vector<TrackRecord> records;
-  std::string line;
   long long number = 0;
-  while (std::getline(in, line)) {
+  for (std::size_t start = 0; start < text.size();) {
     ++number;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    const LineError error(path, number);
+    const std::size_t newline = text.find('\n', start);
+    const std::size_t end = newline == std::string_view::npos ? text.size() : newline;
+    std::string_view line = text.substr(start, end - start);
+    start = end + 1;
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    const LineError error(name, number);
     if (number == 1) {
       if (line != kCsvHeader) {
         error.fail("header " + quoted_excerpt(line) + " is not '" + std::string(kCsvHeader) + "'");
@@ -231,10 +238,22 @@ std::vector<TrackRecord> read_track_csv(const std::string& path) {
     }
     records.push_back(parse_row(line, error));
   }
-  if (in.bad()) throw Error("cannot read track log '" + path + "'");
   if (number == 0)
-    LineError(path, 1).fail("empty file, expected '" + std::string(kCsvHeader) + "'");
+    LineError(name, 1).fail("empty file, expected '" + std::string(kCsvHeader) + "'");
   return records;
+}
+
+std::vector<TrackRecord> read_track_csv(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    throw Error("cannot read track log '" + path + "': no such file");
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error("cannot open track log '" + path + "'");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad() || text.bad()) throw Error("cannot read track log '" + path + "'");
+  return parse_track_csv(text.str(), path);
 }
 
 }  // namespace roiflow::stages

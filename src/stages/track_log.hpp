@@ -22,6 +22,7 @@
 #include <fstream>
 #include <opencv2/core.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace roiflow::stages {
@@ -61,9 +62,11 @@ class TrackLogWriter {
 };
 
 // Reads a CSV written by TrackLogWriter. Strict, because scores are computed from it: the header
-// must match exactly, every row holds 10 fields, numbers parse completely and are finite, mode
-// is local|global and lost 0|1. Windows line ends are accepted. Anything else throws
-// roiflow::Error as `path:line: what was wrong`.
+// must match exactly, every row holds 10 fields, numbers parse completely and are finite (box and
+// velocity within the float range), mode is local|global and lost 0|1. Windows line ends are
+// accepted. Anything else throws roiflow::Error as `path:line: what was wrong`.
 std::vector<TrackRecord> read_track_csv(const std::string& path);
+// The same from a file's text held in memory; `name` stands for the path in error messages.
+std::vector<TrackRecord> parse_track_csv(std::string_view text, const std::string& name);
 
 }  // namespace roiflow::stages

@@ -126,10 +126,13 @@ void TrackerParams::validate() const {
   lk.validate();
   if (init) {
     const cv::Rect2f& b = *init;
+    // Bounded so that the box's corners convert to int pixel coordinates without overflow.
+    constexpr float kFar = 1e6f;
     if (!(std::isfinite(b.x) && std::isfinite(b.y) && std::isfinite(b.width) &&
-          std::isfinite(b.height) && b.width >= 2 && b.height >= 2)) {
+          std::isfinite(b.height) && b.width >= 2 && b.height >= 2 && std::abs(b.x) <= kFar &&
+          std::abs(b.y) <= kFar && b.width <= kFar && b.height <= kFar)) {
       throw Error("tracker: init box " + box_text(b) +
-                  " must be finite with sides of at least 2 pixels");
+                  " must be finite, within 1e6 pixels of the origin, with sides of 2..1e6 pixels");
     }
   }
   local.validate();

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -18,6 +20,7 @@
 #include <vector>
 
 #include "flow/error.hpp"
+#include "flow/tracking_scene.hpp"
 
 namespace roiflow::stages {
 
@@ -69,6 +72,41 @@ bool is_image_extension(std::string extension) {
   for (const char* known : {".jpg", ".jpeg", ".png", ".bmp", ".pgm", ".ppm", ".tif", ".tiff"})
     if (extension == known) return true;
   return false;
+}
+
+// Why `bytes`, a PNG or JPEG file, is cut short or damaged in its structure, or "" when it
+// looks whole (other formats: ""). Decoders print their complaints about such files on stderr
+// and, for JPEG, return the picture with its missing part gray: a silently wrong frame.
+std::string image_damage(const std::vector<uchar>& bytes) {
+  const auto byte_at = [&](std::size_t i) { return static_cast<unsigned>(bytes[i]); };
+  static constexpr unsigned char kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (bytes.size() >= 8 && std::equal(kPng, kPng + 8, bytes.begin())) {
+    // Chunks: 4-byte big-endian length, 4-letter type, data, 4-byte CRC; the last is IEND.
+    std::size_t at = 8;
+    while (at + 12 <= bytes.size()) {
+      const std::size_t length =
+          byte_at(at) << 24 | byte_at(at + 1) << 16 | byte_at(at + 2) << 8 | byte_at(at + 3);
+      for (std::size_t k = at + 4; k < at + 8; ++k)
+        if (!std::isalpha(static_cast<unsigned char>(bytes[k])))
+          return "damaged PNG (no valid chunk at byte " + std::to_string(at) + ")";
+      if (std::string_view(reinterpret_cast<const char*>(&bytes[at + 4]), 4) == "IEND") return {};
+      if (length > bytes.size() - at - 12) break;
+      at += length + 12;
+    }
+    return "truncated PNG (it ends before its IEND chunk)";
+  }
+  if (bytes.size() >= 3 && byte_at(0) == 0xFF && byte_at(1) == 0xD8 && byte_at(2) == 0xFF) {
+    // Inside entropy-coded data 0xFF is always followed by 0x00 or a restart marker, so an
+    // FF D9 after the first start-of-scan (FF DA) is the end-of-image marker.
+    bool scan = false;
+    for (std::size_t i = 2; i + 1 < bytes.size(); ++i) {
+      if (byte_at(i) != 0xFF) continue;
+      if (byte_at(i + 1) == 0xDA) scan = true;
+      if (scan && byte_at(i + 1) == 0xD9) return {};
+    }
+    return "truncated JPEG (no end-of-image marker after its image data)";
+  }
+  return {};
 }
 
 // The sorted entry names of `dir`; throws naming `dir` when it cannot be listed.
@@ -209,15 +247,15 @@ class SequenceReader : public VideoSource::Reader {
     }
     const std::string& path = paths_[static_cast<std::size_t>(index)];
     std::error_code ec;
-    // Checked first: the file may have gone since the folder was listed, and cv::imread would
-    // only print a warning of its own.
+    // Checked first: the file may have gone since the folder was listed.
     if (!fs::is_regular_file(path, ec)) {
       failure = "missing file " + quoted(path);
       return false;
     }
-    image = cv::imread(path, cv::IMREAD_ANYCOLOR);
-    if (image.empty()) {
-      failure = "cannot decode image " + quoted(path);
+    try {
+      image = read_image(path, cv::IMREAD_ANYCOLOR);
+    } catch (const Error& e) {
+      failure = e.what();
       return false;
     }
     timestamp_s = static_cast<double>(index) / fps_;
@@ -255,6 +293,12 @@ class CaptureReader : public VideoSource::Reader {
       capture_.open(path, cv::CAP_FFMPEG);
       if (!capture_.isOpened())
         throw Error("cannot open " + label_ + ": not a video the FFmpeg backend can read");
+    }
+    if (!camera_) {
+      // Checked before the first frame is decoded: a huge frame would be allocated by then.
+      const cv::Size announced(static_cast<int>(capture_.get(cv::CAP_PROP_FRAME_WIDTH)),
+                               static_cast<int>(capture_.get(cv::CAP_PROP_FRAME_HEIGHT)));
+      if (announced.width > 0 && announced.height > 0) check_frame_size(announced, label_);
     }
     const double reported = capture_.get(cv::CAP_PROP_FPS);
     fps_ = std::isfinite(reported) && reported > 0 ? reported : default_fps;
@@ -315,6 +359,93 @@ class CaptureReader : public VideoSource::Reader {
   }
 };
 
+// Why frames of `size` cannot be processed ("10000x10000: larger than ..."), or "" when they can.
+std::string frame_size_problem(cv::Size size) {
+  const long long pixels = static_cast<long long>(size.width) * size.height;
+  if (size.width > kMaxFrameSide || size.height > kMaxFrameSide || pixels > kMaxFramePixels)
+    return size_string(size) + ": larger than the limit of " + std::to_string(kMaxFrameSide) +
+           " px a side and " + std::to_string(kMaxFramePixels / 1'000'000) + " Mpixel";
+  if (size.width < kMinFrameSide || size.height < kMinFrameSide)
+    return size_string(size) + ": smaller than the minimum of " + std::to_string(kMinFrameSide) +
+           " px a side";
+  return {};
+}
+
+// "synthetic:N[:WxH]": the tracking scene played forwards and backwards, rendered on demand.
+class SyntheticReader : public VideoSource::Reader {
+ public:
+  static constexpr int kSceneFrames = 300;
+
+  SyntheticReader(long long frames, cv::Size size, double fps)
+      : frames_(frames), fps_(fps), scene_(scene_params(size)) {}
+
+  bool read(long long index, cv::Mat& image, double& timestamp_s, std::string&) override {
+    if (index >= frames_) return false;
+    // Mirrored so that the vehicle turns back instead of leaping to the start: the only jumps
+    // are the scene's own, which the tracker's global treatment has to catch.
+    const long long period = 2 * (kSceneFrames - 1);
+    const long long phase = index % period;
+    image = scene_.render(static_cast<int>(phase < kSceneFrames ? phase : period - phase));
+    timestamp_s = static_cast<double>(index) / fps_;
+    return true;
+  }
+
+  double fps() const override { return fps_; }
+  long long frame_count() const override { return frames_; }
+  std::string description() const override {
+    return "synthetic scene (" + std::to_string(frames_) + " frames, " + number_string(fps_) +
+           " fps)";
+  }
+
+ private:
+  long long frames_;
+  double fps_;
+  flow::TrackingScene scene_;
+
+  static flow::TrackingSceneParams scene_params(cv::Size size) {
+    flow::TrackingSceneParams params;
+    params.size = size;
+    params.frames = kSceneFrames;
+    // The default vehicle and jump are drawn for 640 px: scaled so that any size keeps the
+    // same picture (the vehicle at least 8 px, as the scene requires).
+    const float scale = static_cast<float>(size.width) / 640.f;
+    params.object = {std::max(8.f, params.object.width * scale),
+                     std::max(8.f, params.object.height * scale)};
+    params.jump *= scale;
+    return params;
+  }
+};
+
+constexpr std::string_view kSyntheticPrefix = "synthetic:";
+
+std::unique_ptr<VideoSource::Reader> open_synthetic(const std::string& input, double fps) {
+  const auto bad = [&](const std::string& why) {
+    return Error("bad synthetic input " + quoted(input) + ": " + why +
+                 " (expected synthetic:N or synthetic:N:WxH, like synthetic:1000:640x480)");
+  };
+  std::string_view spec = std::string_view(input).substr(kSyntheticPrefix.size());
+  const auto colon = spec.find(':');
+  const std::string_view count_text = spec.substr(0, colon);
+  const auto count = all_digits(count_text) ? parse_number(count_text) : std::nullopt;
+  if (!count || *count < 1 || *count > 1'000'000'000)
+    throw bad("the frame count must be in 1..1000000000");
+  cv::Size size(640, 480);
+  if (colon != std::string_view::npos) {
+    const std::string_view size_text = spec.substr(colon + 1);
+    const auto x = size_text.find('x');
+    const std::string_view w = size_text.substr(0, x);
+    const std::string_view h = x == std::string_view::npos ? "" : size_text.substr(x + 1);
+    const auto width = all_digits(w) ? parse_number(w) : std::nullopt;
+    const auto height = all_digits(h) ? parse_number(h) : std::nullopt;
+    if (!width || !height || *width < 64 || *height < 64 || *width > kMaxFrameSide ||
+        *height > kMaxFrameSide)
+      throw bad("the size must be WxH with each side in 64.." + std::to_string(kMaxFrameSide));
+    size = {static_cast<int>(*width), static_cast<int>(*height)};
+    check_frame_size(size, "synthetic input " + quoted(input));
+  }
+  return std::make_unique<SyntheticReader>(*count, size, fps);
+}
+
 // The camera index that `input` names, or -1 when it is not one.
 int camera_index(const std::string& input) {
   if (!all_digits(input)) return -1;
@@ -340,6 +471,7 @@ std::unique_ptr<VideoSource::Reader> open_reader(const std::string& input, doubl
                 " or its img/ folder: expected numbered images like 0001.jpg");
   }
   if (fs::exists(status)) return std::make_unique<CaptureReader>(input, -1, fps);
+  if (input.starts_with(kSyntheticPrefix)) return open_synthetic(input, fps);
   if (input.find('%') != std::string::npos) {
     const Pattern pattern = parse_pattern(input);
     const Numbered numbered = find_pattern_files(pattern);
@@ -350,6 +482,25 @@ std::unique_ptr<VideoSource::Reader> open_reader(const std::string& input, doubl
 }
 
 }  // namespace
+
+cv::Mat read_image(const std::string& path, int flags) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error("cannot open image " + quoted(path));
+  const std::vector<uchar> bytes((std::istreambuf_iterator<char>(in)),
+                                 std::istreambuf_iterator<char>());
+  if (in.bad()) throw Error("cannot read image " + quoted(path));
+  if (bytes.empty()) throw Error("cannot decode image " + quoted(path) + ": empty file");
+  if (const std::string damage = image_damage(bytes); !damage.empty())
+    throw Error("cannot decode image " + quoted(path) + ": " + damage);
+  cv::Mat image = cv::imdecode(bytes, flags);
+  if (image.empty()) throw Error("cannot decode image " + quoted(path));
+  return image;
+}
+
+void check_frame_size(cv::Size size, const std::string& what) {
+  if (const std::string problem = frame_size_problem(size); !problem.empty())
+    throw Error(what + " is " + problem);
+}
 
 VideoSource::VideoSource(const std::string& input, const VideoSourceParams& params)
     : params_(params) {
@@ -416,7 +567,14 @@ std::optional<Frame> VideoSource::read_frame(long long index, std::string& failu
               "): expected 8-bit gray or BGR";
     return std::nullopt;
   }
-  if (!size_.empty() && frame.image.size() != size_) {
+  if (size_.empty()) {
+    // The first frame: checked before a gray copy of a huge image is made.
+    failure = frame_size_problem(frame.image.size());
+    if (!failure.empty()) {
+      failure = "frame size " + failure;
+      return std::nullopt;
+    }
+  } else if (frame.image.size() != size_) {
     failure = "frame size " + size_string(frame.image.size()) + " differs from the first frame's " +
               size_string(size_);
     return std::nullopt;

@@ -1,6 +1,7 @@
 // VideoSource: frames, in order, from a video file, an image-sequence folder or a camera.
 //
-//   roiflow::stages::VideoSource source("data/Car4");          // or "car.mp4", "img/%04d.jpg", "0"
+//   roiflow::stages::VideoSource source("data/Car4");  // or "car.mp4", "img/%04d.jpg", "0",
+//                                                      // "synthetic:1000"
 //   while (auto frame = source.next()) track(frame->gray, frame->index, frame->timestamp_s);
 //   if (source.status().state == SourceStatus::State::kStopped) {
 //     std::cerr << source.status().message << '\n';           // "stopped at frame 41: ..."
@@ -17,11 +18,24 @@
 //   - an existing file: a video, read with OpenCV's FFmpeg backend.
 //   - a path holding one printf conversion (%d, %4d or %04d), like "img/%04d.jpg": an image
 //     sequence made of the files of that folder that match, run as above.
+//   - "synthetic:N" or "synthetic:N:WxH" (when no such file exists): N frames (1..10^9) of
+//     flow::TrackingScene's fixed-camera scene, WxH (default 640x480, each side 64..8192; the
+//     vehicle and its jump scaled with the width), rendered on the fly. The scene is 300
+//     frames long and plays forwards, then backwards, then forwards again (frame i shows scene
+//     frame i mod 598, mirrored past 299), so a stream of any length holds one scene and one
+//     frame at a time: the input of soak runs.
+//
+// Frame size limits: every frame must be at most kMaxFrameSide pixels a side and kMaxFramePixels
+// pixels in all (8K UHD, 7680x4320, fits), and at least kMinFrameSide a side (the smallest
+// pyramid level LK can work on). A video whose container announces a size out of range is
+// refused before any frame is decoded; an image is refused once decoded, before any buffer
+// of the pipeline is allocated for it.
 //
 // Errors at construction: every one of these throws roiflow::Error naming the input: a path
 // that does not exist, a directory without an image sequence, a pattern nothing matches, a
-// file the FFmpeg backend cannot open, a camera that does not open, bad params, and an input
-// that opens but yields no first frame (empty or corrupt file, `start` past the end). The first
+// file the FFmpeg backend cannot open, a camera that does not open, bad params, a frame size
+// out of the limits above, a malformed "synthetic:" input, and an input that opens but yields
+// no first frame (empty or corrupt file, `start` past the end). The first
 // frame is decoded in the constructor so that size() is known and a bad input fails before
 // any work starts.
 //
@@ -33,7 +47,8 @@
 // next() returns std::nullopt, from then on, and status() says kStopped with the message
 // "stopped at frame N: <reason>", N being the index the frame would have had. Reasons: a
 // missing file in a sequence (a gap in the numbering: the files after it are not read; the
-// message names the missing file), an image that cannot be decoded, a frame whose size differs
+// message names the missing file), an image that cannot be decoded or is a truncated or damaged
+// PNG or JPEG (see read_image), a frame whose size differs
 // from the first one's (the pipeline needs one size), a video that ends more than ~1% short of
 // the frame count its container announces (truncated or corrupt; OpenCV does not tell a
 // decode error from the end, and counts estimated from the duration can be off by a frame or
@@ -48,7 +63,24 @@
 #include <optional>
 #include <string>
 
+#include "flow/pyramid.hpp"
+
 namespace roiflow::stages {
+
+inline constexpr int kMinFrameSide = flow::kMinLevelSide;  // one pyramid level
+inline constexpr int kMaxFrameSide = 8192;
+inline constexpr long long kMaxFramePixels = 40'000'000;
+
+// Throws roiflow::Error when `size` is out of the limits above, naming `what` (e.g. "image
+// 'a.png'") and the size. flow and eval apply it to their images too.
+void check_frame_size(cv::Size size, const std::string& what);
+
+// The image file at `path`, decoded with cv::imdecode(`flags`). Throws roiflow::Error naming
+// the file when it cannot be read or decoded, and also when a PNG or JPEG file is cut short or
+// its chunk structure is damaged, which decoders would otherwise report only on stderr (and,
+// for JPEG, answer with a picture whose missing part is gray). Image sequences read their
+// frames with it.
+cv::Mat read_image(const std::string& path, int flags);
 
 struct VideoSourceParams {
   double fps = 25;           // frame rate of image sequences, and of videos or cameras that
