@@ -12,7 +12,6 @@
 
 #include "flow/error.hpp"
 #include "pipeline/tbb_executor.hpp"
-#include "pipeline/tsan_annotations.hpp"
 
 namespace roiflow::pipeline {
 namespace {
@@ -85,7 +84,6 @@ class Run {
   }
 
   const GraphOptions& options() const { return options_; }
-  void* token() { return &token_; }
 
  private:
   const GraphOptions& options_;
@@ -93,7 +91,6 @@ class Run {
   std::atomic<long long> max_alive_{0};
   std::unordered_map<long long, int> votes_;  // touched by the serial retire node only
   long long retired_ = 0;
-  char token_ = 0;  // see BodyScope
 };
 
 int thread_count(const GraphOptions& options) {
@@ -171,7 +168,6 @@ class FrontEnd {
     level_nodes_.reserve(static_cast<std::size_t>(levels));
     for (int level = 0; level < levels; ++level) {
       level_nodes_.emplace_back(g, tf::unlimited, [this, level, levels, sigma](FrameMsg m) {
-        const BodyScope scope(run_.token());
         if (level == 0) {
           run_.admitted();
           run_.enter(Stage::Pyramid, m.seq);
@@ -201,7 +197,6 @@ class FrontEnd {
 
  private:
   FrameMsg next(oneapi::tbb::flow_control& fc) {
-    const BodyScope scope(run_.token());
     if (run_.cancel_requested()) {
       cancelled_ = true;
       fc.stop();
@@ -237,7 +232,6 @@ using RetireNode = tf::multifunction_node<RetireMsg, std::tuple<tf::continue_msg
 
 RetireNode make_retire_node(tf::graph& g, Run& run, int votes_needed) {
   return RetireNode(g, tf::serial, [&run, votes_needed](const RetireMsg& m, auto& ports) {
-    const BodyScope scope(run.token());
     if (run.vote(m, votes_needed)) std::get<0>(ports).try_put(tf::continue_msg());
   });
 }
@@ -253,7 +247,6 @@ std::vector<tf::function_node<Msg, RetireMsg>> make_sink_nodes(tf::graph& g, Run
   nodes.reserve(std::max<std::size_t>(1, sinks.size()));
   for (const Sink& sink : sinks) {
     nodes.emplace_back(g, tf::serial, [&run, &sink, retire_offset](const Msg& m) {
-      const BodyScope scope(run.token());
       run.enter(Stage::Sink, m.seq);
       const auto t0 = Clock::now();
       sink.consume(m);
@@ -273,7 +266,6 @@ std::vector<tf::function_node<Msg, RetireMsg>> make_sink_nodes(tf::graph& g, Run
 RunReport finish(tf::graph& g, Run& run, FrontEnd& front, Clock::time_point start) {
   front.start();
   g.wait_for_all();
-  tsan_acquire(run.token());  // every body's writes happen before the report reads them
   return run.report(std::chrono::duration<double>(Clock::now() - start).count(), front.cancelled());
 }
 
@@ -324,7 +316,6 @@ RunReport run_tracking(const FrameSource& source, const TrackStep& step,
     FrontEnd front(g, run, source, limit, step.levels, step.sigma);
 
     tf::function_node<FrameMsg, TrackedFrame> track(g, tf::serial, [&](const FrameMsg& m) {
-      const BodyScope scope(run.token());
       run.enter(Stage::Track, m.seq);
       const auto t0 = Clock::now();
       TrackedFrame out;
@@ -368,7 +359,6 @@ RunReport run_dense(const FrameSource& source, const flow::LkParams& params,
     using PairNode = tf::multifunction_node<FrameMsg, std::tuple<PairJob, RetireMsg>>;
     std::optional<FrameMsg> previous;
     PairNode pair(g, tf::serial, [&](const FrameMsg& m, PairNode::output_ports_type& ports) {
-      const BodyScope scope(run.token());
       if (previous) {
         std::get<0>(ports).try_put(PairJob{previous->seq, *previous, m});
       } else {
@@ -379,7 +369,6 @@ RunReport run_dense(const FrameSource& source, const flow::LkParams& params,
     });
 
     tf::function_node<PairJob, FlowPair> flow_node(g, tf::unlimited, [&](const PairJob& job) {
-      const BodyScope scope(run.token());
       run.enter(Stage::Flow, job.seq);
       const auto t0 = Clock::now();
       auto result = std::make_shared<flow::FlowResult>();

@@ -10,7 +10,6 @@
 #include <string>
 
 #include "flow/error.hpp"
-#include "pipeline/tsan_annotations.hpp"
 
 namespace roiflow::pipeline {
 
@@ -42,17 +41,9 @@ void TbbExecutor::for_range(int begin, int end, int grain,
   // auto_partitioner, not simple_partitioner: stripes cost the same per row, so a few big
   // chunks per thread balance as well as many small ones, and every extra stripe repeats the
   // flow core's per-stripe setup. `grain` stays a floor, not the chunk size.
-  // The caller's writes happen before every stripe, every stripe's before the caller goes on.
-  void* token = const_cast<std::function<void(int, int)>*>(&body);
-  tsan_release(token);
   tbb::parallel_for(
-      range,
-      [&body, token](const tbb::blocked_range<int>& r) {
-        const BodyScope scope(token);
-        body(r.begin(), r.end());
-      },
+      range, [&body](const tbb::blocked_range<int>& r) { body(r.begin(), r.end()); },
       tbb::auto_partitioner());
-  tsan_acquire(token);
 }
 
 int TbbExecutor::concurrency() const {

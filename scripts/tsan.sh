@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# The concurrency tests under ThreadSanitizer: the flow-graph, stripe-executor, tracker,
+# cancellation and soak tests (the tsan test preset's filter), against a oneTBB built with TSan.
+#
+#   scripts/tsan.sh
+#
+# Debian's oneTBB is not instrumented, so scripts/tsan_tbb.sh first builds Debian's own oneTBB
+# source with -fsanitize=thread (once, ~1 minute); the tsan preset links it. What TSan cannot see
+# into (OpenCV, FFmpeg) is listed in tests/tsan.supp with the reason.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/deps.sh
+scripts/tsan_tbb.sh
+cmake --preset tsan >/dev/null
+cmake --build --preset tsan -j"$(nproc)"
+ctest --preset tsan -j"$(nproc)"
