@@ -131,12 +131,7 @@ TEST_F(CompareCliTest, BadCommandLinesFailWithOneLine) {
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.expected);
-    const CliResult r = run(c.args);
-    EXPECT_EQ(r.exit_code, c.exit_code) << r.err;
-    ASSERT_EQ(lines_of(r.err).size(), 1u) << r.err;
-    EXPECT_EQ(r.err.rfind("roiflow: error: ", 0), 0u) << r.err;
-    EXPECT_NE(r.err.find(c.expected), std::string::npos) << r.err;
-    EXPECT_TRUE(r.out.empty()) << r.out;
+    test::expect_one_error_line(run(c.args), c.exit_code, c.expected);
     EXPECT_FALSE(fs::exists(path("cmp")));
   }
 }

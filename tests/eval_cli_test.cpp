@@ -192,12 +192,7 @@ TEST_F(EvalCliTest, BadTreesAndOptionsFailInOneLineLeavingNoFile) {
     for (const std::string& arg : c.args)
       shown += " " + arg;
     SCOPED_TRACE("roiflow" + shown);
-    const CliResult r = run(c.args);
-    EXPECT_EQ(r.exit_code, c.exit_code) << r.err;
-    EXPECT_EQ(split(r.err, '\n').size(), 1u) << r.err;
-    EXPECT_EQ(r.err.rfind("roiflow: error: ", 0), 0u) << r.err;
-    EXPECT_NE(r.err.find(c.expected), std::string::npos) << r.err;
-    EXPECT_TRUE(r.out.empty()) << r.out;
+    test::expect_one_error_line(run(c.args), c.exit_code, c.expected);
     EXPECT_FALSE(fs::exists(out));
     EXPECT_FALSE(fs::exists(report));
   }

@@ -73,6 +73,16 @@ struct CliResult {
   std::string err;
 };
 
+// A failed run: exit code `exit_code`, nothing on stdout, one line on stderr, that line
+// "roiflow: error: ..." holding `expected`.
+inline void expect_one_error_line(const CliResult& r, int exit_code, const std::string& expected) {
+  EXPECT_EQ(r.exit_code, exit_code) << r.err;
+  EXPECT_EQ(lines_of(r.err).size(), 1u) << r.err;
+  EXPECT_EQ(r.err.rfind("roiflow: error: ", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+}
+
 #ifdef ROIFLOW_CLI_PATH
 // Runs the roiflow CLI with `args` through the shell (each argument quoted), its stdout and
 // stderr going to two files that are read back and removed.

@@ -12,6 +12,7 @@
 
 #include "flow/error.hpp"
 #include "stages/quote.hpp"
+#include "stages/text_file.hpp"
 
 namespace roiflow::stages {
 namespace {
@@ -95,32 +96,16 @@ cv::Rect2f parse_box(std::string_view line, const std::string& where) {
 
 std::vector<cv::Rect2f> parse_ground_truth(std::string_view text, const std::string& name) {
   std::vector<cv::Rect2f> boxes;
-  long long number = 0;
-  for (std::size_t start = 0; start < text.size();) {
-    ++number;
-    const std::size_t newline = text.find('\n', start);
-    const std::size_t end = newline == std::string_view::npos ? text.size() : newline;
-    std::string_view line = text.substr(start, end - start);
-    start = end + 1;
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    if (line.find_first_not_of(" \t") == std::string_view::npos) continue;
+  for_each_line(text, [&](long long number, std::string_view line) {
+    if (line.find_first_not_of(" \t") == std::string_view::npos) return;
     boxes.push_back(parse_box(line, name + ":" + std::to_string(number) + ": "));
-  }
+  });
   if (boxes.empty()) throw Error("ground truth '" + name + "' holds no box");
   return boxes;
 }
 
 std::vector<cv::Rect2f> read_ground_truth(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    throw Error("cannot read ground truth '" + path + "': no such file");
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error("cannot open ground truth '" + path + "'");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad() || text.bad()) throw Error("cannot read ground truth '" + path + "'");
-  return parse_ground_truth(text.str(), path);
+  return parse_ground_truth(read_text_file(path, "ground truth"), path);
 }
 
 std::vector<cv::Rect2f> track_boxes(const std::vector<TrackRecord>& records) {

@@ -14,6 +14,7 @@
 
 #include "flow/error.hpp"
 #include "stages/quote.hpp"
+#include "stages/text_file.hpp"
 
 namespace roiflow::stages {
 namespace {
@@ -221,39 +222,22 @@ void TrackLogWriter::check_stream(const char* action) {
 
 std::vector<TrackRecord> parse_track_csv(std::string_view text, const std::string& name) {
   std::vector<TrackRecord> records;
-  long long number = 0;
-  for (std::size_t start = 0; start < text.size();) {
-    ++number;
-    const std::size_t newline = text.find('\n', start);
-    const std::size_t end = newline == std::string_view::npos ? text.size() : newline;
-    std::string_view line = text.substr(start, end - start);
-    start = end + 1;
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+  const long long lines = for_each_line(text, [&](long long number, std::string_view line) {
     const LineError error(name, number);
     if (number == 1) {
       if (line != kCsvHeader) {
         error.fail("header " + quoted_excerpt(line) + " is not '" + std::string(kCsvHeader) + "'");
       }
-      continue;
+      return;
     }
     records.push_back(parse_row(line, error));
-  }
-  if (number == 0)
-    LineError(name, 1).fail("empty file, expected '" + std::string(kCsvHeader) + "'");
+  });
+  if (lines == 0) LineError(name, 1).fail("empty file, expected '" + std::string(kCsvHeader) + "'");
   return records;
 }
 
 std::vector<TrackRecord> read_track_csv(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    throw Error("cannot read track log '" + path + "': no such file");
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error("cannot open track log '" + path + "'");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad() || text.bad()) throw Error("cannot read track log '" + path + "'");
-  return parse_track_csv(text.str(), path);
+  return parse_track_csv(read_text_file(path, "track log"), path);
 }
 
 }  // namespace roiflow::stages
