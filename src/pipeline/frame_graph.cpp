@@ -328,12 +328,20 @@ RunReport run_tracking(const FrameSource& source, const TrackStep& step,
       return out;
     });
 
+    // The tracker is serial, but oneTBB does not keep the order of what one serial node puts
+    // to the next when consecutive messages leave from different threads (about one in ten
+    // thousand; oneTBB issue 289): a sequencer restores it before the sinks.
+    tf::sequencer_node<TrackedFrame> track_order(
+        g, [](const TrackedFrame& f) { return static_cast<std::size_t>(f.seq); });
+    tf::broadcast_node<TrackedFrame> to_sinks(g);  // a sequencer feeds one successor only
     auto sink_nodes = make_sink_nodes<TrackedFrame>(g, run, sinks, 0);
     RetireNode retire = make_retire_node(g, run, static_cast<int>(sink_nodes.size()));
 
     tf::make_edge(front.output(), track);
+    tf::make_edge(track, track_order);
+    tf::make_edge(track_order, to_sinks);
     for (auto& node : sink_nodes) {
-      tf::make_edge(track, node);
+      tf::make_edge(to_sinks, node);
       tf::make_edge(node, retire);
     }
     tf::make_edge(tf::output_port<0>(retire), front.retire_port());
