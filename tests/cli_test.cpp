@@ -18,6 +18,7 @@
 #include "flow/flo_io.hpp"
 #include "flow/synthetic.hpp"
 #include "flow/tracking_scene.hpp"
+#include "scene_video.hpp"
 #include "stages/track_log.hpp"
 #include "test_util.hpp"
 
@@ -322,27 +323,12 @@ class CliVideoTest : public CliTest {
   // ground-truth boxes as an OTB file.
   void SetUp() override {
     CliTest::SetUp();
-    flow::TrackingSceneParams params;
-    params.size = {160, 120};
-    params.frames = 30;
-    params.object = {28.f, 18.f};
-    params.jump = 10.0;
-    scene_ = std::make_unique<flow::TrackingScene>(params);
-    cv::VideoWriter writer(path("scene.avi"), cv::CAP_FFMPEG,
-                           cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 25.0, params.size);
-    ASSERT_TRUE(writer.isOpened());
+    scene_ = test::write_scene_video(path("scene.avi"), 30);
     std::ofstream truth(path("truth.txt"));
-    for (int i = 0; i < scene_->frames(); ++i) {
-      writer.write(scene_->render(i));
-      const cv::Rect2f b = scene_->box(i);
-      truth << b.x << "," << b.y << "," << b.width << "," << b.height << "\n";
-    }
+    for (int i = 0; i < scene_->frames(); ++i)
+      truth << test::box_text(scene_->box(i)) << "\n";
   }
-  std::string init_box() const {
-    const cv::Rect2f b = scene_->box(0);
-    return std::to_string(b.x) + "," + std::to_string(b.y) + "," + std::to_string(b.width) + "," +
-           std::to_string(b.height);
-  }
+  std::string init_box() const { return test::box_text(scene_->box(0)); }
   std::unique_ptr<flow::TrackingScene> scene_;
 };
 

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "flow/tracking_scene.hpp"
+#include "scene_video.hpp"
 #include "stages/track_log.hpp"
 #include "test_util.hpp"
 
@@ -31,24 +32,10 @@ class CompareCliTest : public test::TempDirTest {
   // The demo's scene, 160x120, 24 frames, as MJPG .avi.
   void SetUp() override {
     TempDirTest::SetUp();
-    flow::TrackingSceneParams params;
-    params.size = {160, 120};
-    params.frames = 24;
-    params.object = {28.f, 18.f};
-    params.jump = 10.0;
-    scene_ = std::make_unique<flow::TrackingScene>(params);
-    cv::VideoWriter writer(path("scene.avi"), cv::CAP_FFMPEG,
-                           cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 25.0, params.size);
-    ASSERT_TRUE(writer.isOpened());
-    for (int i = 0; i < scene_->frames(); ++i)
-      writer.write(scene_->render(i));
+    scene_ = test::write_scene_video(path("scene.avi"), 24);
   }
 
-  std::string init_box() const {
-    const cv::Rect2f b = scene_->box(0);
-    return std::to_string(b.x) + "," + std::to_string(b.y) + "," + std::to_string(b.width) + "," +
-           std::to_string(b.height);
-  }
+  std::string init_box() const { return test::box_text(scene_->box(0)); }
 
   CliResult run(const std::vector<std::string>& args) const {
     return run_cli(args, path("stdout.txt"), path("stderr.txt"));
