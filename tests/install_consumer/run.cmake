@@ -1,6 +1,6 @@
 # Installs the current build into a fresh prefix, builds the consumer project against it and
 # runs it. Called by ctest (tests/CMakeLists.txt) with -DBUILD_DIR= -DSOURCE_DIR= -DWORK_DIR=
-# -DGENERATOR=.
+# -DGENERATOR= and, for a sanitizer build, -DSANITIZE= (its -fsanitize list).
 foreach(var BUILD_DIR SOURCE_DIR WORK_DIR GENERATOR)
   if(NOT DEFINED ${var})
     message(FATAL_ERROR "install consumer: -D${var}= is required")
@@ -42,8 +42,18 @@ endforeach()
 
 run_step("the installed CLI" ${prefix}/bin/roiflow --help)
 
+# Libraries built with a sanitizer need its runtime in the program that links them: a consumer
+# of such a build compiles and links with the same -fsanitize (the package does not impose it).
+set(consumer_flags "")
+if(SANITIZE)
+  set(consumer_flags "-fsanitize=${SANITIZE}")
+  if(SANITIZE MATCHES "undefined")
+    string(APPEND consumer_flags " -fno-sanitize=vptr")
+  endif()
+endif()
 run_step("configuring the consumer" ${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${WORK_DIR}/build
-         -G ${GENERATOR} -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${prefix})
+         -G ${GENERATOR} -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${prefix}
+         "-DCMAKE_CXX_FLAGS=${consumer_flags}" "-DCMAKE_EXE_LINKER_FLAGS=${consumer_flags}")
 run_step("building the consumer" ${CMAKE_COMMAND} --build ${WORK_DIR}/build)
 foreach(app flow_consumer pipeline_consumer)
   run_step("running ${app}" ${WORK_DIR}/build/${app})
