@@ -32,8 +32,6 @@
 #include "stages/track_log.hpp"
 #include "test_util.hpp"
 
-extern char** environ;
-
 namespace {
 
 namespace fs = std::filesystem;
@@ -63,25 +61,12 @@ class BadInputTest : public test::TempDirTest {
  protected:
   // Runs the CLI with `args`; killed (and reported as timed out) after kTimeout.
   Outcome run(const std::vector<std::string>& args) const {
-    std::vector<std::string> argv_text = {ROIFLOW_CLI_PATH};
-    argv_text.insert(argv_text.end(), args.begin(), args.end());
-    std::vector<char*> argv;
-    for (std::string& arg : argv_text)
-      argv.push_back(arg.data());
-    argv.push_back(nullptr);
     const std::string out_path = path("stdout.txt"), err_path = path("stderr.txt");
-    posix_spawn_file_actions_t files;
-    posix_spawn_file_actions_init(&files);
-    posix_spawn_file_actions_addopen(&files, 1, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
-                                     0644);
-    posix_spawn_file_actions_addopen(&files, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
-                                     0644);
-    pid_t pid = 0;
-    const int spawned = posix_spawn(&pid, argv[0], &files, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&files);
+    int spawned = 0;
+    const pid_t pid = test::spawn_cli(args, out_path, err_path, &spawned);
     Outcome outcome;
-    if (spawned != 0) {
-      ADD_FAILURE() << "cannot start " << argv[0] << ": " << std::strerror(spawned);
+    if (pid < 0) {
+      ADD_FAILURE() << "cannot start " << ROIFLOW_CLI_PATH << ": " << std::strerror(spawned);
       return outcome;
     }
     const auto deadline = std::chrono::steady_clock::now() + kTimeout;

@@ -28,8 +28,6 @@
 #include "stages/track_log.hpp"
 #include "test_util.hpp"
 
-extern char** environ;
-
 namespace {
 
 namespace fs = std::filesystem;
@@ -75,22 +73,7 @@ class CancelTest : public test::TempDirTest {
 
   // Starts the CLI with stdout and stderr going to files.
   pid_t spawn(const std::vector<std::string>& args) const {
-    std::vector<std::string> argv_text = {ROIFLOW_CLI_PATH};
-    argv_text.insert(argv_text.end(), args.begin(), args.end());
-    std::vector<char*> argv;
-    for (std::string& a : argv_text)
-      argv.push_back(a.data());
-    argv.push_back(nullptr);
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    const std::string out = path("stdout.txt");
-    const std::string err = path("stderr.txt");
-    posix_spawn_file_actions_addopen(&actions, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addopen(&actions, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    pid_t pid = -1;
-    const int rc = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    return rc == 0 ? pid : -1;
+    return test::spawn_cli(args, path("stdout.txt"), path("stderr.txt"));
   }
 
   // Waits (up to `limit_s`) until `ready` holds or the child has exited; false when it exited.

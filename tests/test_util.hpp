@@ -5,7 +5,9 @@
 //   CliResult r = run_cli({"eval", dir}, path("stdout.txt"), path("stderr.txt"));
 #pragma once
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <spawn.h>
 #include <stdlib.h>
 #include <sys/wait.h>
 
@@ -19,6 +21,8 @@
 #include <vector>
 
 #include "flow/error.hpp"
+
+extern "C" char** environ;
 
 namespace roiflow::test {
 
@@ -84,6 +88,27 @@ inline void expect_one_error_line(const CliResult& r, int exit_code, const std::
 }
 
 #ifdef ROIFLOW_CLI_PATH
+// Starts the roiflow CLI with `args` (no shell), stdout and stderr going to the two files.
+// Returns its pid, or -1 with posix_spawn's error in `*error`.
+inline pid_t spawn_cli(const std::vector<std::string>& args, const std::string& out_path,
+                       const std::string& err_path, int* error = nullptr) {
+  std::vector<std::string> argv_text = {ROIFLOW_CLI_PATH};
+  argv_text.insert(argv_text.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& arg : argv_text)
+    argv.push_back(arg.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t files;
+  posix_spawn_file_actions_init(&files);
+  posix_spawn_file_actions_addopen(&files, 1, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_addopen(&files, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  pid_t pid = -1;
+  const int rc = posix_spawn(&pid, argv[0], &files, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&files);
+  if (error != nullptr) *error = rc;
+  return rc == 0 ? pid : -1;
+}
+
 // Runs the roiflow CLI with `args` through the shell (each argument quoted), its stdout and
 // stderr going to two files that are read back and removed.
 inline CliResult run_cli(const std::vector<std::string>& args, const std::string& out_path,
