@@ -86,5 +86,25 @@ TEST(TemplateSearch, RejectsBadInput) {
             std::string::npos);
 }
 
+TEST(TemplateSearch, DirectNccEqualsOpenCvsMatchTemplate) {
+  cv::Mat image(41, 57, CV_32F), templ(23, 30, CV_32F);
+  cv::randu(image, 0.f, 1.f);
+  cv::randu(templ, 0.f, 1.f);
+  image(cv::Rect(0, 0, 40, 25)).setTo(0.25f);  // flat windows: OpenCV's rule gives 0 there
+  image(cv::Rect(9, 5, 30, 23)) = 0.5f * image(cv::Rect(9, 5, 30, 23)) + templ;
+  cv::Mat direct, reference;
+  ccoeff_normed_direct(image, templ, direct);
+  cv::matchTemplate(image, templ, reference, cv::TM_CCOEFF_NORMED);
+  ASSERT_EQ(direct.size(), reference.size());
+  EXPECT_LT(cv::norm(direct, reference, cv::NORM_INF), 1e-4);
+  double best = 0;
+  cv::Point at;
+  cv::minMaxLoc(direct, nullptr, &best, nullptr, &at);
+  EXPECT_EQ(at, cv::Point(9, 5));
+  EXPECT_GT(best, 0.85);
+  EXPECT_NE(error_message([&] { ccoeff_normed_direct(templ, image, direct); }).find("no larger"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace roiflow::stages
