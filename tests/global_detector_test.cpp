@@ -251,6 +251,10 @@ TEST(GlobalDetector, BadInputsThrowNamingTheValue) {
   detector.observe(cv::Mat(48, 64, CV_8UC3, cv::Scalar::all(0)));
   EXPECT_NE(error_message([&] { detector.observe(cv::Mat(48, 60, CV_8UC3)); }).find("60x48"),
             std::string::npos);
+  EXPECT_NE(error_message([&] {
+              detector.observe(cv::Mat(48, 64, CV_8UC3, cv::Scalar::all(0)), 0.0);
+            }).find("weight"),
+            std::string::npos);
   const cv::Mat frame(48, 64, CV_8UC3, cv::Scalar::all(90));
   EXPECT_NE(error_message([&] {
               detector.set_target(frame, {70, 10, 20, 20});
@@ -270,6 +274,27 @@ TEST(GlobalDetector, BadInputsThrowNamingTheValue) {
               detector.find_target(frame, cv::Mat(48, 64, CV_32FC1), {}, true);
             }).find("32FC1"),
             std::string::npos);
+}
+
+// An observation that stands for many frames learns as much as they would: a block that
+// appears and stays is learnt into the background after a few heavy observations, while as
+// many plain ones still see it as a moving object.
+TEST(GlobalDetector, AHeavierObservationLearnsFaster) {
+  cv::Mat background(240, 320, CV_8UC3);
+  cv::RNG rng(11);
+  rng.fill(background, cv::RNG::UNIFORM, 40, 200);
+  cv::Mat with_block = background.clone();
+  with_block(cv::Rect(120, 80, 60, 50)).setTo(cv::Scalar(20, 220, 240));
+  for (double weight : {1.0, 20.0}) {
+    GlobalDetectorParams params;
+    params.warmup = 2;
+    GlobalDetector detector(params);
+    for (int i = 0; i < 10; ++i)
+      detector.observe(background);
+    for (int i = 0; i < 6; ++i)
+      detector.observe(with_block, weight);
+    EXPECT_EQ(detector.moving_objects().empty(), weight > 1.0) << "weight " << weight;
+  }
 }
 
 }  // namespace

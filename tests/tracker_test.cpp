@@ -209,6 +209,8 @@ TEST(Tracker, BadParamsThrowNamingTheValue) {
   EXPECT_NE(message([](auto& p) { p.init = cv::Rect2f(1, 2, 0.5f, 10); }).find("0.5"),
             std::string::npos);
   EXPECT_NE(message([](auto& p) { p.camera_motion = -2; }).find("-2"), std::string::npos);
+  EXPECT_NE(message([](auto& p) { p.held_learning = 1.5; }).find("held_learning"),
+            std::string::npos);
   EXPECT_NE(message([](auto& p) { p.local.min_appearance = 3; }).find("got 3"), std::string::npos);
   EXPECT_NE(message([](auto& p) { p.detector.history = 1; }).find("got 1"), std::string::npos);
 }

@@ -278,8 +278,11 @@ GlobalDetector::GlobalDetector(const GlobalDetectorParams& params)
   s.close_kernel = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(7, 7));
 }
 
-void GlobalDetector::observe(const cv::Mat& image) {
+void GlobalDetector::observe(const cv::Mat& image, double weight) {
   check_image(image, "frame");
+  if (!(weight > 0) || !std::isfinite(weight)) {
+    throw Error("global detector: observation weight must be > 0, got " + number_text(weight));
+  }
   Impl& s = *impl_;
   if (s.frame_size.empty()) {
     s.frame_size = image.size();
@@ -303,7 +306,7 @@ void GlobalDetector::observe(const cv::Mat& image) {
   // A fixed learning rate, not MOG2's default 1/(2n) of the first frames: that one learns a
   // slow object into the background within a few frames. At 1/history the first frame's
   // content fades from the background in about a tenth of the history.
-  s.model->apply(*input, s.fg_raw, 1.0 / s.params.history);
+  s.model->apply(*input, s.fg_raw, std::min(1.0, weight / s.params.history));
   // Opening removes isolated noise pixels; closing joins the pieces of one
   // object that the model split where the object looks like the background.
   cv::morphologyEx(s.fg_raw, s.foreground, cv::MORPH_OPEN, s.open_kernel);

@@ -53,9 +53,11 @@ class GlobalDetector {
  public:
   explicit GlobalDetector(const GlobalDetectorParams& params = {});
 
-  // Updates the background model with a frame (8-bit BGR or gray, one size for a run). Call it
-  // for every frame, in order, whether or not detection is needed on that frame.
-  void observe(const cv::Mat& image);
+  // Updates the background model with a frame (8-bit BGR or gray, one size for a run), in order.
+  // The frame stands for `weight` frames of video (> 0): the model learns at
+  // min(1, weight / history), so a caller that observes only every k-th frame can keep the
+  // model's memory in frames of video by passing k.
+  void observe(const cv::Mat& image, double weight = 1.0);
   // Moving objects of the last observed frame, biggest first; empty during warm-up.
   std::vector<Detection> moving_objects() const;
 

@@ -143,6 +143,9 @@ void TrackerParams::validate() const {
     throw Error("tracker: observe_interval must be in 1..1000, got " +
                 std::to_string(observe_interval));
   }
+  if (!(held_learning > 0 && held_learning <= 1)) {
+    throw Error("tracker: held_learning must be in (0, 1], got " + number_text(held_learning));
+  }
   detector.validate();
 }
 
@@ -187,10 +190,11 @@ struct Tracker::Impl {
   void acquire(const TrackerInput& frame, TrackerOutput& out);
   void follow(const TrackerInput& frame, TrackerOutput& out);
 
-  // The background model is only needed to find a target that was not given.
-  void observe(const TrackerInput& frame) {
+  // The background model is only needed to find a target that was not given. `weight`: the
+  // frames of video this observation stands for.
+  void observe(const TrackerInput& frame, double weight = 1.0) {
     if (params.init || observed_index == frame.index) return;
-    detector.observe(frame.image.empty() ? frame.gray : frame.image);
+    detector.observe(frame.image.empty() ? frame.gray : frame.image, weight);
     observed_index = frame.index;
   }
 };
@@ -290,7 +294,11 @@ TrackerOutput Tracker::Impl::process(const TrackerInput& frame) {
     throw Error("tracker: frame " + number_text(static_cast<double>(frame.index)) +
                 ": the pyramid must be built from gray with pyramid_levels() levels");
   }
-  if (!has_target || lost || frame.index % params.observe_interval == 0) observe(frame);
+  if (!has_target || lost) {
+    observe(frame);
+  } else if (frame.index % params.observe_interval == 0) {
+    observe(frame, params.observe_interval * params.held_learning);
+  }
 
   TrackerOutput out;
   out.index = frame.index;
