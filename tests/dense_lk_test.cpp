@@ -338,6 +338,33 @@ TEST(DenseLkTest, ASmallerContextChangesTheFlowOnlyNearTheRegionBorder) {
   }
 }
 
+// The pyramids of only the footprint (plus a border for the smoothing and pyrDown, origin on
+// the coarsest level's grid) give the flow the whole-frame pyramids give: what lets a tracker
+// build pyramids of a small part of each frame.
+TEST(DenseLkTest, PyramidsOfTheFootprintGiveTheRegionsFlow) {
+  const Scene s = make_scene(SceneKind::Rotation, kSize, 4);
+  for (int context : {8, -1}) {
+    SCOPED_TRACE("context " + std::to_string(context));
+    FlowOptions options;
+    options.region = cv::Rect(110, 80, 90, 70);
+    options.context = context;
+    const LkParams params = LkParams::paper();
+    const cv::Rect footprint = flow_footprint(s.frame0.size(), params, options);
+    EXPECT_TRUE((footprint & options.region) == options.region);
+    EXPECT_GT(footprint.area(), options.region.area());
+    const FlowResult whole = dense_flow(s.frame0, s.frame1, params, options);
+    const int align = 1 << (params.levels - 1);
+    const int x0 = std::max(0, (footprint.x - 16) / align * align);
+    const int y0 = std::max(0, (footprint.y - 16) / align * align);
+    const cv::Rect crop = cv::Rect(cv::Point(x0, y0), footprint.br() + cv::Point(16, 16)) &
+                          cv::Rect(cv::Point(), s.frame0.size());
+    FlowOptions inside = options;
+    inside.region = options.region - crop.tl();
+    const FlowResult part = dense_flow(s.frame0(crop), s.frame1(crop), params, inside);
+    EXPECT_LT(max_abs_diff(part.flow, whole.flow), 1e-3);
+  }
+}
+
 TEST(DenseLkTest, RegionOutsideTheFrameThrows) {
   const Scene s = make_scene(SceneKind::Translation, {160, 120}, 2);
   for (const cv::Rect region : {cv::Rect(160, 0, 10, 10), cv::Rect(-30, -30, 30, 30),

@@ -23,11 +23,16 @@ namespace {
 
 using test::error_message;
 
-std::shared_ptr<const flow::Pyramid> pyramid_of(const cv::Mat& bgr,
-                                                const LocalTrackerParams& p = {}) {
-  cv::Mat gray;
-  cv::cvtColor(bgr, gray, cv::COLOR_BGR2GRAY);
-  return std::make_shared<flow::Pyramid>(flow::build_pyramid(gray, p.lk.levels, p.lk.sigma));
+// The frame as the local treatment gets it: its gray image, with its whole pyramid or without.
+LocalFrame frame_of(const cv::Mat& bgr, const LocalTrackerParams& p = {},
+                    bool with_pyramid = false) {
+  LocalFrame f;
+  cv::cvtColor(bgr, f.gray, cv::COLOR_BGR2GRAY);
+  if (with_pyramid) {
+    f.pyramid =
+        std::make_shared<flow::Pyramid>(flow::build_pyramid(f.gray, p.lk.levels, p.lk.sigma));
+  }
+  return f;
 }
 
 flow::TrackingSceneParams small_scene(double jump, double scale_change) {
@@ -50,10 +55,10 @@ struct TrackRun {
 // Tracks frames [1, last] of `scene` from the true box of frame 0.
 TrackRun track(const flow::TrackingScene& scene, int last, const LocalTrackerParams& p = {}) {
   LocalTracker tracker(p);
-  tracker.start(pyramid_of(scene.render(0), p), scene.box(0));
+  tracker.start(frame_of(scene.render(0), p), scene.box(0));
   TrackRun run;
   for (int i = 1; i <= last; ++i) {
-    run.results.push_back(tracker.track(pyramid_of(scene.render(i), p)));
+    run.results.push_back(tracker.track(frame_of(scene.render(i), p)));
     const LocalResult& r = run.results.back();
     if (r.lost) {
       ++run.lost;
@@ -126,14 +131,14 @@ TEST(LocalTracker, RestartPlacesTheObjectAgain) {
   const flow::TrackingScene scene(small_scene(60.0, 0.0));
   const int jump = scene.jump_frame();
   LocalTracker tracker;
-  tracker.start(pyramid_of(scene.render(0)), scene.box(0));
+  tracker.start(frame_of(scene.render(0)), scene.box(0));
   for (int i = 1; i < jump; ++i)
-    tracker.track(pyramid_of(scene.render(i)));
-  ASSERT_TRUE(tracker.track(pyramid_of(scene.render(jump))).lost);
-  tracker.restart(pyramid_of(scene.render(jump)), scene.box(jump));
+    tracker.track(frame_of(scene.render(i)));
+  ASSERT_TRUE(tracker.track(frame_of(scene.render(jump))).lost);
+  tracker.restart(frame_of(scene.render(jump)), scene.box(jump));
   EXPECT_EQ(tracker.velocity(), cv::Point2f(0.f, 0.f));
   for (int i = jump + 1; i < jump + 10; ++i) {
-    const LocalResult r = tracker.track(pyramid_of(scene.render(i)));
+    const LocalResult r = tracker.track(frame_of(scene.render(i)));
     EXPECT_FALSE(r.lost) << "frame " << i;
     EXPECT_LT(center_error(r.box, scene.box(i)), 2.0) << "frame " << i;
   }
@@ -142,10 +147,10 @@ TEST(LocalTracker, RestartPlacesTheObjectAgain) {
 TEST(LocalTracker, LosesAnObjectReplacedByFlatGray) {
   const flow::TrackingScene scene(small_scene(0.0, 0.0));
   LocalTracker tracker;
-  tracker.start(pyramid_of(scene.render(0)), scene.box(0));
-  ASSERT_FALSE(tracker.track(pyramid_of(scene.render(1))).lost);
+  tracker.start(frame_of(scene.render(0)), scene.box(0));
+  ASSERT_FALSE(tracker.track(frame_of(scene.render(1))).lost);
   const cv::Mat flat(scene.size(), CV_8UC3, cv::Scalar::all(128));
-  const LocalResult r = tracker.track(pyramid_of(flat));
+  const LocalResult r = tracker.track(frame_of(flat));
   EXPECT_TRUE(r.lost);
   EXPECT_TRUE(r.reason == LostReason::LowTexture || r.reason == LostReason::FewInliers)
       << to_string(r.reason);
@@ -160,6 +165,25 @@ TEST(LocalTracker, WholeFrameGivesTheSameTrack) {
   for (std::size_t i = 0; i < whole.results.size(); ++i) {
     EXPECT_EQ(whole.results[i].region.size(), scene.size());
     EXPECT_LT(center_error(whole.results[i].box, local.results[i].box), 0.5) << "frame " << i;
+  }
+}
+
+// The local treatment builds pyramids of its region only; a whole-frame pyramid given with
+// each frame changes nothing (it is used only in whole-frame mode, where it is the same).
+TEST(LocalTracker, AGivenWholePyramidChangesNothing) {
+  const flow::TrackingScene scene(small_scene(0.0, 0.15));
+  for (bool whole_frame : {false, true}) {
+    LocalTrackerParams p;
+    p.whole_frame = whole_frame;
+    LocalTracker without(p), with(p);
+    without.start(frame_of(scene.render(0), p), scene.box(0));
+    with.start(frame_of(scene.render(0), p, true), scene.box(0));
+    for (int i = 1; i <= 15; ++i) {
+      const LocalResult a = without.track(frame_of(scene.render(i), p));
+      const LocalResult b = with.track(frame_of(scene.render(i), p, true));
+      EXPECT_EQ(a.box, b.box) << "frame " << i << (whole_frame ? " whole frame" : "");
+      EXPECT_EQ(cv::norm(a.region_flow, b.region_flow, cv::NORM_INF), 0.0) << "frame " << i;
+    }
   }
 }
 
@@ -192,20 +216,20 @@ TEST(LocalTracker, BadParamsThrowNamingTheValue) {
 TEST(LocalTracker, BadBoxesAndFramesThrow) {
   const flow::TrackingScene scene(small_scene(0.0, 0.0));
   LocalTracker tracker;
-  EXPECT_NE(error_message([&] { tracker.track(pyramid_of(scene.render(1))); }).find("start"),
+  EXPECT_NE(error_message([&] { tracker.track(frame_of(scene.render(1))); }).find("start"),
             std::string::npos);
   EXPECT_NE(error_message([&] {
-              tracker.start(pyramid_of(scene.render(0)), cv::Rect2f(500, 10, 20, 20));
+              tracker.start(frame_of(scene.render(0)), cv::Rect2f(500, 10, 20, 20));
             }).find("500"),
             std::string::npos);
   EXPECT_NE(error_message([&] {
-              tracker.start(pyramid_of(scene.render(0)), cv::Rect2f(10, 10, NAN, 20));
+              tracker.start(frame_of(scene.render(0)), cv::Rect2f(10, 10, NAN, 20));
             }).find("nan"),
             std::string::npos);
-  tracker.start(pyramid_of(scene.render(0)), scene.box(0));
+  tracker.start(frame_of(scene.render(0)), scene.box(0));
   cv::Mat larger;
   cv::resize(scene.render(1), larger, cv::Size(400, 300));
-  const std::string m = error_message([&] { tracker.track(pyramid_of(larger)); });
+  const std::string m = error_message([&] { tracker.track(frame_of(larger)); });
   EXPECT_NE(m.find("400 x 300"), std::string::npos) << m;
   EXPECT_NE(m.find("320 x 240"), std::string::npos) << m;
 }

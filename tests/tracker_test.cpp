@@ -31,21 +31,30 @@ flow::TrackingSceneParams small_scene(double jump) {
   return p;
 }
 
-TrackerInput input(const Tracker& tracker, const cv::Mat& bgr, long long index) {
+// The frame with its whole pyramid (`pyramid`: always, never, or when the tracker wants one,
+// as the pipeline does).
+enum class Pyramids { Always, Never, WhenWanted };
+
+TrackerInput input(const Tracker& tracker, const cv::Mat& bgr, long long index,
+                   Pyramids pyramids = Pyramids::Always) {
   TrackerInput in;
   in.index = index;
   in.image = bgr;
   cv::cvtColor(bgr, in.gray, cv::COLOR_BGR2GRAY);
-  in.pyramid = std::make_shared<flow::Pyramid>(
-      flow::build_pyramid(in.gray, tracker.pyramid_levels(), tracker.pyramid_sigma()));
+  if (pyramids == Pyramids::Always ||
+      (pyramids == Pyramids::WhenWanted && tracker.wants_pyramid())) {
+    in.pyramid = std::make_shared<flow::Pyramid>(
+        flow::build_pyramid(in.gray, tracker.pyramid_levels(), tracker.pyramid_sigma()));
+  }
   return in;
 }
 
-std::vector<TrackerOutput> run(const flow::TrackingScene& scene, TrackerParams params) {
+std::vector<TrackerOutput> run(const flow::TrackingScene& scene, TrackerParams params,
+                               Pyramids pyramids = Pyramids::Always) {
   Tracker tracker(params);
   std::vector<TrackerOutput> outs;
   for (int i = 0; i < scene.frames(); ++i)
-    outs.push_back(tracker.process(input(tracker, scene.render(i), i)));
+    outs.push_back(tracker.process(input(tracker, scene.render(i), i, pyramids)));
   EXPECT_EQ(tracker.global_activations(), outs.back().global_activations);
   return outs;
 }
@@ -236,11 +245,54 @@ TEST(Tracker, FrameSizeChangeThrows) {
   EXPECT_NE(m.find("320 x 240"), std::string::npos) << m;
 }
 
-TEST(Tracker, MissingPyramidOrColourGrayThrows) {
+// Whole-frame pyramids only save the tracker work: with them, without them, or only when it
+// wants them, every output is the same.
+TEST(Tracker, TheWholeFramePyramidsNeverChangeTheResult) {
+  const flow::TrackingScene scene(small_scene(48.0));
+  TrackerParams detect;
+  detect.detector.warmup = 2;
+  for (const TrackerParams& params :
+       {with_init(scene), with_init(scene, TrackMode::Global), detect}) {
+    const std::vector<TrackerOutput> always = run(scene, params);
+    for (Pyramids p : {Pyramids::Never, Pyramids::WhenWanted}) {
+      const std::vector<TrackerOutput> other = run(scene, params, p);
+      ASSERT_EQ(other.size(), always.size());
+      for (std::size_t i = 0; i < always.size(); ++i) {
+        EXPECT_EQ(other[i].box, always[i].box) << "frame " << i;
+        EXPECT_EQ(other[i].lost, always[i].lost) << "frame " << i;
+        EXPECT_EQ(other[i].global_activations, always[i].global_activations) << "frame " << i;
+      }
+    }
+  }
+}
+
+TEST(Tracker, WantsWholePyramidsOnlyInGlobalModeOrUntilTheTargetIsKnown) {
+  const flow::TrackingScene scene(small_scene(0.0));
+  Tracker local(with_init(scene));
+  Tracker global(with_init(scene, TrackMode::Global));
+  TrackerParams detect_params;
+  detect_params.detector.warmup = 2;
+  Tracker detect(detect_params);
+  for (Tracker* t : {&local, &global, &detect})
+    EXPECT_TRUE(t->wants_pyramid());
+  bool found = false;
+  for (int i = 0; i < 12; ++i) {
+    local.process(input(local, scene.render(i), i));
+    global.process(input(global, scene.render(i), i));
+    found = detect.process(input(detect, scene.render(i), i)).has_target;
+    EXPECT_FALSE(local.wants_pyramid());
+    EXPECT_TRUE(global.wants_pyramid());
+    EXPECT_EQ(detect.wants_pyramid(), !found) << "frame " << i;
+  }
+  EXPECT_TRUE(found);
+}
+
+TEST(Tracker, AWrongPyramidOrColourGrayThrows) {
   const flow::TrackingScene scene(small_scene(0.0));
   Tracker tracker(with_init(scene));
   TrackerInput in = input(tracker, scene.render(0), 0);
-  in.pyramid.reset();
+  in.pyramid = std::make_shared<flow::Pyramid>(flow::build_pyramid(
+      cv::Mat(100, 100, CV_8UC1, cv::Scalar(0)), tracker.pyramid_levels(), 0.5));
   EXPECT_NE(error_message([&] { tracker.process(in); }).find("pyramid"), std::string::npos);
   in = input(tracker, scene.render(0), 0);
   in.gray = scene.render(0);

@@ -693,6 +693,36 @@ void median_filter(cv::Mat& u, cv::Mat& v, int ksize) {
   cv::medianBlur(v, v, ksize);
 }
 
+// The rectangle each level computes, coarsest last: the region (level 0) or the finer level's
+// rectangle halved (coarser ones), plus the margin its iterations read, clipped to the level.
+std::vector<cv::Rect> computed_rects(cv::Size size, const LkParams& params,
+                                     const FlowOptions& options, const cv::Rect& region) {
+  const int levels = effective_levels(size, params.levels);
+  const Window win = make_window(params.patch, params.derivative == Derivative::HornSchunck);
+  // Flow at a pixel after one iteration depends on the previous flow within the window plus
+  // the derivative stencil: computing on a margin of this many pixels per iteration makes a
+  // region's flow equal the whole frame's flow inside the region (up to rounding).
+  if (options.context < -1 || options.context > 1000) {
+    throw Error("flow context must be in -1..1000 pixels, got " + std::to_string(options.context));
+  }
+  const int reach = win.reach() + 2;
+  const int margin =
+      options.context >= 0
+          ? options.context
+          : params.iterations * reach + std::max(params.level_median, params.final_median) / 2;
+  std::vector<cv::Rect> comp(levels);
+  cv::Rect need = region;
+  cv::Size level_size = size;  // pyrDown's: (w + 1) / 2 x (h + 1) / 2
+  for (int l = 0; l < levels; ++l) {
+    if (l > 0) level_size = cv::Size((level_size.width + 1) / 2, (level_size.height + 1) / 2);
+    comp[l] = expand(need, margin) & cv::Rect(cv::Point(), level_size);
+    const cv::Rect& c = comp[l];
+    need = cv::Rect(cv::Point(c.x / 2, c.y / 2),
+                    cv::Point((c.x + c.width - 1) / 2 + 2, (c.y + c.height - 1) / 2 + 2));
+  }
+  return comp;
+}
+
 // Dense flow from pyramids with `ws`'s buffers (params already validated).
 void flow_from_pyramids(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkParams& params,
                         FlowResult& result, const FlowOptions& options, Workspace& ws) {
@@ -709,27 +739,7 @@ void flow_from_pyramids(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkPar
 
   const bool half_grid = params.derivative == Derivative::HornSchunck;
   const Window win = make_window(params.patch, half_grid);
-  // Flow at a pixel after one iteration depends on the previous flow within the window plus
-  // the derivative stencil: computing on a margin of this many pixels per iteration makes a
-  // region's flow equal the whole frame's flow inside the region (up to rounding).
-  if (options.context < -1 || options.context > 1000) {
-    throw Error("flow context must be in -1..1000 pixels, got " + std::to_string(options.context));
-  }
-  const int reach = win.reach() + 2;
-  const int margin =
-      options.context >= 0
-          ? options.context
-          : params.iterations * reach + std::max(params.level_median, params.final_median) / 2;
-
-  std::vector<cv::Rect> comp(levels);
-  cv::Rect need = region;
-  for (int l = 0; l < levels; ++l) {
-    const cv::Rect level_rect(cv::Point(), pyr_t.levels[l].size());
-    comp[l] = expand(need, margin) & level_rect;
-    const cv::Rect& c = comp[l];
-    need = cv::Rect(cv::Point(c.x / 2, c.y / 2),
-                    cv::Point((c.x + c.width - 1) / 2 + 2, (c.y + c.height - 1) / 2 + 2));
-  }
+  const std::vector<cv::Rect> comp = computed_rects(size, params, options, region);
 
   const SerialExecutor serial;
   const Executor& exec = options.executor ? *options.executor : serial;
@@ -787,6 +797,20 @@ void flow_from_pyramids(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkPar
 }
 
 }  // namespace
+
+cv::Rect flow_footprint(cv::Size size, const LkParams& params, const FlowOptions& options) {
+  params.validate();
+  const cv::Rect full(cv::Point(), size);
+  const cv::Rect region = options.region.empty() ? full : (options.region & full);
+  if (region.empty()) throw Error("flow region lies outside the frame");
+  cv::Rect out = region;
+  const std::vector<cv::Rect> comp = computed_rects(size, params, options, region);
+  for (std::size_t l = 0; l < comp.size(); ++l) {
+    const int f = 1 << l;
+    out |= cv::Rect(comp[l].x * f, comp[l].y * f, comp[l].width * f, comp[l].height * f);
+  }
+  return out & full;
+}
 
 LkParams LkParams::paper() {
   return LkParams{};

@@ -102,6 +102,12 @@ void dense_flow(const cv::Mat& frame_t, const cv::Mat& frame_t1, const LkParams&
 void dense_flow(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkParams& params,
                 FlowResult& result, const FlowOptions& options = {});
 
+// The level-0 pixels of frame t whose values dense_flow reads for `options` (the rectangles it
+// computes at every level, scaled to level 0; the warps of frame t+1 reach further by the
+// flow itself). A caller that builds pyramids of only part of a frame builds them over this
+// (see stages::LocalTracker). `size`: the frame's.
+cv::Rect flow_footprint(cv::Size size, const LkParams& params, const FlowOptions& options);
+
 const char* to_string(Derivative d);
 Derivative derivative_from_string(std::string_view name);  // "hs", "scharr", "central"
 

@@ -159,8 +159,12 @@ void build_base_level(const cv::Mat& gray, double sigma, int levels, flow::Pyram
 // source -> limiter -> level 0 -> level 1 -> ... -> sequencer: the part both modes share.
 class FrontEnd {
  public:
-  FrontEnd(tf::graph& g, Run& run, const FrameSource& source, int limit, int levels, double sigma)
+  // `wanted` (may be empty: always) says whether the consumer wants whole-frame pyramids now;
+  // frames it does not want them for go on without one.
+  FrontEnd(tf::graph& g, Run& run, const FrameSource& source, int limit, int levels, double sigma,
+           std::function<bool()> wanted = {})
       : run_(run),
+        wanted_(std::move(wanted)),
         source_(source),
         input_(g, [this](oneapi::tbb::flow_control& fc) { return next(fc); }),
         limiter_(g, static_cast<std::size_t>(limit)),
@@ -171,7 +175,9 @@ class FrontEnd {
         if (level == 0) {
           run_.admitted();
           run_.enter(Stage::Pyramid, m.seq);
+          if (wanted_ && !wanted_()) m.pyramid.reset();  // back to the pool
         }
+        if (!m.pyramid) return m;
         const auto start = Clock::now();
         flow::Pyramid& pyr = *m.pyramid;
         if (level == 0) {
@@ -218,6 +224,7 @@ class FrontEnd {
   }
 
   Run& run_;
+  std::function<bool()> wanted_;
   const FrameSource& source_;
   long long seq_ = 0;  // the input node's body runs serially
   bool cancelled_ = false;
@@ -304,6 +311,7 @@ RunReport run_tracking(const FrameSource& source, stages::Tracker& tracker,
   step.levels = tracker.pyramid_levels();
   step.sigma = tracker.pyramid_sigma();
   step.process = [&tracker](const stages::TrackerInput& in) { return tracker.process(in); };
+  step.wants_pyramid = [&tracker] { return tracker.wants_pyramid(); };
   return run_tracking(source, step, sinks, options);
 }
 
@@ -313,7 +321,7 @@ RunReport run_tracking(const FrameSource& source, const TrackStep& step,
   return run_in_arena(options, [&](int limit, Clock::time_point start) {
     Run run(options);
     tf::graph g;
-    FrontEnd front(g, run, source, limit, step.levels, step.sigma);
+    FrontEnd front(g, run, source, limit, step.levels, step.sigma, step.wants_pyramid);
 
     tf::function_node<FrameMsg, TrackedFrame> track(g, tf::serial, [&](const FrameMsg& m) {
       run.enter(Stage::Track, m.seq);

@@ -18,7 +18,9 @@
 //                        limiter ◄─ retire ◄─ sinks (one serial node each) ◄─┘ sequencer,
 //                                                                              broadcast
 // Decoding and the pyramids of later frames run ahead of the tracker (different frames and
-// different levels of different frames at once), bounded by the limiter: at most
+// different levels of different frames at once), bounded by the limiter; whole-frame pyramids
+// are built only while the tracker wants them (global mode, target not yet known: the local
+// treatment builds pyramids of its region itself, which costs a fraction of a whole one): at most
 // `max_in_flight` frames exist between the source and their retirement, whatever the length of
 // the stream. The tracker is the serial critical path (its region for frame t+1 comes from its
 // decision at t); it parallelises inside through the TbbExecutor it was given (row tiles of
@@ -97,6 +99,9 @@ struct TrackStep {
   int levels = 3;
   double sigma = 0.5;
   std::function<stages::TrackerOutput(const stages::TrackerInput&)> process;
+  // Optional, thread-safe: false when the step does not want whole-frame pyramids for the next
+  // frames (Tracker::wants_pyramid); those frames then come with a null pyramid. Empty: always.
+  std::function<bool()> wants_pyramid;
 };
 RunReport run_tracking(const FrameSource& source, const TrackStep& step,
                        const std::vector<TrackSink>& sinks, const GraphOptions& options = {});

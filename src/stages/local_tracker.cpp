@@ -88,14 +88,44 @@ constexpr float kScaleTolerance = 0.05f;
 // The largest size change accepted between two frames.
 constexpr double kMaxScaleChange = 1.25;
 
-// The appearance at `b` in level 0 of `pyr`, sub-pixel placed (pixel i covers [i, i + 1), so
-// the box's centre is at pixel coordinate c - 0.5).
-void cut(const flow::Pyramid& pyr, const cv::Rect2f& b, cv::Mat& out) {
-  const cv::Point2f c = centre(b);
+// The appearance at `b` (frame pixels) in level 0 of `pyr`, the pyramid of the part of the
+// frame whose top-left pixel is `origin`, sub-pixel placed (pixel i covers [i, i + 1), so the
+// box's centre is at pixel coordinate c - 0.5).
+void cut(const flow::Pyramid& pyr, cv::Point origin, const cv::Rect2f& b, cv::Mat& out) {
+  const cv::Point2f c = centre(b) - cv::Point2f(origin);
   cv::getRectSubPix(
       pyr.levels[0],
       cv::Size(static_cast<int>(std::lround(b.width)), static_cast<int>(std::lround(b.height))),
       cv::Point2f(c.x - 0.5f, c.y - 0.5f), out, CV_32F);
+}
+
+// Level `l` of a pyramid part (`rect` of the frame at level 0, origin on the coarsest level's
+// grid) is the rectangle `rect` / 2^l of the frame's level l; sizes as pyrDown makes them.
+cv::Rect level_rect(const cv::Rect& rect, int l) {
+  int w = rect.width, h = rect.height;
+  for (int i = 0; i < l; ++i) {
+    w = (w + 1) / 2;
+    h = (h + 1) / 2;
+  }
+  return {rect.x >> l, rect.y >> l, w, h};
+}
+
+// A pyramid of part of a frame: `rect` (level-0 pixels) and its levels.
+struct PartPyramid {
+  cv::Rect rect;
+  flow::Pyramid pyr;
+};
+
+// The levels of `part` restricted to `want` (inside part.rect, both origins on the grid):
+// views, no copy.
+void view(const PartPyramid& part, const cv::Rect& want, flow::Pyramid& out) {
+  out.levels.resize(part.pyr.levels.size());
+  for (std::size_t l = 0; l < out.levels.size(); ++l) {
+    const int li = static_cast<int>(l);
+    const cv::Rect have = level_rect(part.rect, li);
+    const cv::Rect w = level_rect(want, li);
+    out.levels[l] = part.pyr.levels[l](cv::Rect(w.tl() - have.tl(), w.size()));
+  }
 }
 
 // The best appearance match around a box: centre and size in level-0 pixels, and its NCC.
@@ -161,7 +191,12 @@ const char* to_string(LostReason reason) {
 struct LocalTracker::Impl {
   LocalTrackerParams params;
   const flow::Executor* executor = nullptr;
-  std::shared_ptr<const flow::Pyramid> prev;
+  cv::Size size;                                    // of the frames; empty before start()
+  int levels = 1;                                   // effective pyramid levels at that size
+  cv::Mat prev;                                     // frame t-1's gray image
+  std::shared_ptr<const flow::Pyramid> prev_whole;  // its whole pyramid (whole_frame mode)
+  PartPyramid prev_part;  // the part of frame t-1's pyramid built so far (may be empty)
+  PartPyramid next_part;  // buffers for frame t's part
   cv::Rect2f box;
   cv::Point2f velocity;
   cv::Mat templ;   // CV_32FC1 appearance at level 0, cut at the box given to start()
@@ -169,54 +204,141 @@ struct LocalTracker::Impl {
   int since_recent = 0;
 
   // Buffers reused from frame to frame.
+  flow::Pyramid view_prev, view_cur;
   flow::FlowResult forward;
   flow::FlowResult backward;
   std::vector<cv::Point2f> from, to;
   std::vector<float> conf, work_x, work_y;
   std::vector<int> inliers, consistent;
 
-  void place(std::shared_ptr<const flow::Pyramid> pyramid, const cv::Rect2f& b) {
-    if (!pyramid || pyramid->levels.empty()) throw Error("local tracker: empty pyramid");
+  cv::Rect frame_rect() const { return {cv::Point(), size}; }
+
+  void check_frame(const LocalFrame& f) const {
+    if (f.gray.empty() || f.gray.type() != CV_8UC1) {
+      throw Error(
+          "local tracker: frame must be 8-bit gray, got " +
+          (f.gray.empty() ? std::string("an empty image") : cv::typeToString(f.gray.type())));
+    }
+    if (f.pyramid && (f.pyramid->size() != f.gray.size() || f.pyramid->num_levels() < levels)) {
+      throw Error("local tracker: the pyramid given with a frame is not that frame's");
+    }
+  }
+
+  void place(const LocalFrame& f, const cv::Rect2f& b) {
     if (!(std::isfinite(b.x) && std::isfinite(b.y) && b.width >= 2 && b.height >= 2 &&
           std::isfinite(b.width) && std::isfinite(b.height))) {
       throw Error("local tracker: box (" + number_text(b.x) + ", " + number_text(b.y) + ", " +
                   number_text(b.width) + " x " + number_text(b.height) +
                   ") must be finite with sides of at least 2 pixels");
     }
-    const cv::Size size = pyramid->size();
-    const cv::Rect inside = enclosing(b) & cv::Rect(cv::Point(), size);
+    if (f.gray.empty()) throw Error("local tracker: empty frame");
+    const cv::Size frame_size = f.gray.size();
+    const cv::Rect inside = enclosing(b) & cv::Rect(cv::Point(), frame_size);
     if (inside.width < 2 || inside.height < 2) {
       throw Error("local tracker: box (" + number_text(b.x) + ", " + number_text(b.y) + ", " +
                   number_text(b.width) + " x " + number_text(b.height) +
-                  ") leaves nothing inside the " + number_text(size.width) + " x " +
-                  number_text(size.height) + " frame");
+                  ") leaves nothing inside the " + number_text(frame_size.width) + " x " +
+                  number_text(frame_size.height) + " frame");
     }
-    prev = std::move(pyramid);
+    size = frame_size;
+    levels = flow::effective_levels(size, params.lk.levels);
+    check_frame(f);
+    prev = f.gray;
+    prev_whole = params.whole_frame ? f.pyramid : nullptr;
+    prev_part.rect = cv::Rect();
     box = b;
     velocity = {0.f, 0.f};
   }
 
-  Appearance match(const cv::Mat& appearance, const flow::Pyramid& pyr, const cv::Rect2f& b,
-                   double reach) const;
+  // `r` grown to the coarsest level's pixel grid and to at least kMinLevelSide pixels there
+  // (so that a part keeps every level), clipped to the frame.
+  cv::Rect aligned(const cv::Rect& r) const {
+    const int a = 1 << (levels - 1);
+    const cv::Rect frame = frame_rect();
+    auto floor_to = [a](int v) { return v >= 0 ? v / a * a : -((-v + a - 1) / a) * a; };
+    int x0 = floor_to(r.x), y0 = floor_to(r.y);
+    int x1 = -floor_to(-(r.x + r.width)), y1 = -floor_to(-(r.y + r.height));
+    const int least = flow::kMinLevelSide * a;
+    auto grow = [&](int& lo, int& hi, int extent) {
+      if (hi - lo >= least) return;
+      const int more = (least - (hi - lo) + 2 * a - 1) / (2 * a) * a;
+      lo -= more;
+      hi += more;
+      if (lo < 0) {
+        hi -= lo;
+        lo = 0;
+      }
+      if (hi > extent) {
+        lo = std::max(0, floor_to(lo - (hi - extent)));
+        hi = extent;
+      }
+    };
+    grow(x0, x1, frame.width);
+    grow(y0, y1, frame.height);
+    return cv::Rect(cv::Point(x0, y0), cv::Point(x1, y1)) & frame;
+  }
+
+  // Builds `out` over `rect` of a frame: the whole pyramid when `rect` is the frame and one was
+  // given, else the pyramid of gray(rect).
+  void build(const cv::Mat& gray, const std::shared_ptr<const flow::Pyramid>& whole,
+             const cv::Rect& rect, PartPyramid& out) const {
+    out.rect = rect;
+    if (whole && rect == frame_rect()) {
+      out.pyr = *whole;
+      return;
+    }
+    // Never write into a buffer someone else still shares (a whole pyramid, a view).
+    for (cv::Mat& level : out.pyr.levels) {
+      if (level.u != nullptr && level.u->refcount > 1) level.release();
+    }
+    flow::build_pyramid(gray(rect), params.lk.levels, params.lk.sigma, out.pyr);
+  }
+
+  // The part of the frame a step reads: LK's footprint over the region, the appearance search
+  // around a box that may have moved anywhere in the region, and a border for the smoothing
+  // and pyrDown at the part's edges (where the part's values differ from the whole frame's).
+  cv::Rect step_part(const cv::Rect& region) const {
+    if (params.whole_frame) return frame_rect();
+    flow::FlowOptions o;
+    o.region = region;
+    o.context = params.lk_context;
+    cv::Rect need = flow::flow_footprint(size, params.lk, o);
+    const double side = std::max(box.width, box.height) * kMaxScaleChange;
+    const int search = static_cast<int>(
+        std::ceil(0.5 * side + 2.0 * params.search * std::min(box.width, box.height)));
+    const int border = 3 << (levels - 1);
+    const int motion = static_cast<int>(std::ceil(std::hypot(velocity.x, velocity.y)));
+    need |= cv::Rect(region.x - search, region.y - search, region.width + 2 * search,
+                     region.height + 2 * search);
+    const int m = border + motion;
+    return aligned(cv::Rect(need.x - m, need.y - m, need.width + 2 * m, need.height + 2 * m));
+  }
+
+  Appearance match(const cv::Mat& appearance, const flow::Pyramid& pyr, cv::Point origin,
+                   const cv::Rect2f& b, double reach) const;
   cv::Point2f measure_motion(double& scale);
-  LocalResult track(std::shared_ptr<const flow::Pyramid> pyramid);
+  LocalResult track(const LocalFrame& frame);
 };
 
 // The template matched at 2 * scale_steps + 1 scales around the box's size, on the finest level
 // where the object's shorter side is still at least match_side: NCC's cost grows with the
 // template's area, and a few dozen pixels across are plenty to place and size a whole object.
 Appearance LocalTracker::Impl::match(const cv::Mat& appearance, const flow::Pyramid& pyr,
-                                     const cv::Rect2f& b, double reach) const {
+                                     cv::Point origin, const cv::Rect2f& b, double reach) const {
   const double shorter = std::min(b.width, b.height);
   int level = 0;
   while (level + 1 < pyr.num_levels() && shorter / (2 << level) >= params.match_side)
     ++level;
   const double f = 1.0 / (1 << level);
   const cv::Mat& image = pyr.levels[level];
+  // `pyr` holds the part of the frame from `origin` (on the grid of every level): level-k
+  // pixel i of the part is the frame's level-k pixel i + origin / 2^k.
+  const cv::Point part_k(origin.x >> level, origin.y >> level);
+  const cv::Size frame_k = level_rect(frame_rect(), level).size();
   // Level-k pixel i sits at level-0 pixel i * 2^k: convert through pixel-centre coordinates.
   const cv::Point2f c0 = centre(b);
-  const cv::Point2f ck((c0.x - 0.5f) * static_cast<float>(f) + 0.5f,
-                       (c0.y - 0.5f) * static_cast<float>(f) + 0.5f);
+  const cv::Point2f ck((c0.x - 0.5f) * static_cast<float>(f) + 0.5f - static_cast<float>(part_k.x),
+                       (c0.y - 0.5f) * static_cast<float>(f) + 0.5f - static_cast<float>(part_k.y));
   const double radius = reach * std::max(3.0, params.search * shorter * f);
   const double box_scale = std::sqrt(static_cast<double>(b.area()) / appearance.size().area());
 
@@ -255,35 +377,47 @@ Appearance LocalTracker::Impl::match(const cv::Mat& appearance, const flow::Pyra
   a.size_ratio = std::exp(log_s) / box_scale;
   const cv::Rect2f& m = found[best].box;
   const cv::Rect& w = windows[best];
-  a.at_edge = (m.x < w.x + 1.f && w.x > 0) || (m.y < w.y + 1.f && w.y > 0) ||
-              (m.br().x > static_cast<float>(w.br().x) - 1.f && w.br().x < image.cols) ||
-              (m.br().y > static_cast<float>(w.br().y) - 1.f && w.br().y < image.rows);
-  const cv::Point2f mk = centre(m);
+  // Edges of the frame (not of the part) bound the search: a match there is not at the edge.
+  a.at_edge =
+      (m.x < w.x + 1.f && w.x + part_k.x > 0) || (m.y < w.y + 1.f && w.y + part_k.y > 0) ||
+      (m.br().x > static_cast<float>(w.br().x) - 1.f && w.br().x + part_k.x < frame_k.width) ||
+      (m.br().y > static_cast<float>(w.br().y) - 1.f && w.br().y + part_k.y < frame_k.height);
+  const cv::Point2f mk = centre(m) + cv::Point2f(part_k);
   a.centre = cv::Point2f(static_cast<float>((mk.x - 0.5) / f + 0.5),
                          static_cast<float>((mk.y - 0.5) / f + 0.5));
   return a;
 }
 
-LocalResult LocalTracker::Impl::track(std::shared_ptr<const flow::Pyramid> pyramid) {
-  if (!prev) throw Error("local tracker: track() before start()");
-  if (!pyramid || pyramid->size() != prev->size()) {
-    const cv::Size got = pyramid ? pyramid->size() : cv::Size();
-    throw Error("local tracker: frame is " + number_text(got.width) + " x " +
-                number_text(got.height) + ", the previous one was " +
-                number_text(prev->size().width) + " x " + number_text(prev->size().height));
+LocalResult LocalTracker::Impl::track(const LocalFrame& in) {
+  if (prev.empty()) throw Error("local tracker: track() before start()");
+  if (in.gray.size() != size) {
+    throw Error("local tracker: frame is " + number_text(in.gray.cols) + " x " +
+                number_text(in.gray.rows) + ", the previous one was " + number_text(size.width) +
+                " x " + number_text(size.height));
   }
-  const flow::Pyramid& cur = *pyramid;
-  const cv::Rect frame(cv::Point(), cur.size());
+  check_frame(in);
+  const cv::Rect frame = frame_rect();
   const cv::Rect2f predicted_box(box.x + velocity.x, box.y + velocity.y, box.width, box.height);
 
   LocalResult r;
   r.velocity = velocity;
+  bool built = false;  // frame t's part is in next_part
+  // Frame t becomes frame t-1 of the next step, with the part of its pyramid built so far.
+  auto advance = [&] {
+    prev = in.gray;
+    prev_whole = params.whole_frame ? in.pyramid : nullptr;
+    if (built) {
+      std::swap(prev_part, next_part);
+    } else {
+      prev_part.rect = cv::Rect();
+    }
+  };
   auto lose = [&](LostReason why) {
     r.lost = true;
     r.reason = why;
     r.box = predicted_box;
     box = predicted_box;
-    prev = pyramid;
+    advance();
     return r;
   };
 
@@ -301,12 +435,31 @@ LocalResult LocalTracker::Impl::track(std::shared_ptr<const flow::Pyramid> pyram
   const cv::Rect object = enclosing(box) & r.region;
   if (object.width < 2 || object.height < 2) return lose(LostReason::LeftRegion);
 
+  // The pyramids of the part of frames t-1 and t this step reads. Frame t's part reaches ahead
+  // by the velocity (and a few pixels), where the next step's part of it will most likely be.
+  const cv::Rect part = step_part(r.region);
+  view_prev.levels.clear();  // the last step's views: let go so that builds reuse buffers
+  view_cur.levels.clear();
+  if ((prev_part.rect & part) != part) build(prev, prev_whole, part, prev_part);
+  cv::Rect ahead = part;
+  if (!params.whole_frame) {
+    const cv::Point shift(static_cast<int>(std::lround(velocity.x)),
+                          static_cast<int>(std::lround(velocity.y)));
+    ahead |= part + shift;
+    ahead = aligned(cv::Rect(ahead.x - 4, ahead.y - 4, ahead.width + 8, ahead.height + 8));
+  }
+  build(in.gray, in.pyramid, ahead, next_part);
+  built = true;
+  view(prev_part, part, view_prev);
+  view(next_part, part, view_cur);
+  const cv::Point origin = part.tl();
+
   flow::FlowOptions opt;
-  opt.region = r.region;
+  opt.region = r.region - origin;
   opt.initial_motion = velocity;
   opt.executor = executor;
   opt.context = params.lk_context;
-  flow::dense_flow(*prev, cur, params.lk, forward, opt);
+  flow::dense_flow(view_prev, view_cur, params.lk, forward, opt);
   r.region_flow = forward.flow.clone();
 
   // A regular grid over the object's pixels, in frame t-1, and where the flow takes them.
@@ -342,20 +495,21 @@ LocalResult LocalTracker::Impl::track(std::shared_ptr<const flow::Pyramid> pyram
     cv::Rect2f moved(static_cast<float>(object.x) + rough.x, static_cast<float>(object.y) + rough.y,
                      static_cast<float>(object.width), static_cast<float>(object.height));
     const cv::Rect b = enclosing(moved);
-    opt.region = cv::Rect(b.x - pad, b.y - pad, b.width + 2 * pad, b.height + 2 * pad) & frame;
+    opt.region =
+        (cv::Rect(b.x - pad, b.y - pad, b.width + 2 * pad, b.height + 2 * pad) & part) - origin;
   }
   opt.initial_motion = -rough;
   inliers.clear();
   if (!opt.region.empty()) {
     flow::LkParams back_lk = params.lk;
     back_lk.levels = std::min(params.lk.levels, params.fb_levels);
-    flow::dense_flow(cur, *prev, back_lk, backward, opt);
-    const cv::Point2f origin(static_cast<float>(backward.region.x),
-                             static_cast<float>(backward.region.y));
+    flow::dense_flow(view_cur, view_prev, back_lk, backward, opt);
+    const cv::Point2f back_origin(static_cast<float>(backward.region.x + origin.x),
+                                  static_cast<float>(backward.region.y + origin.y));
     const float limit2 = static_cast<float>(params.fb_threshold * params.fb_threshold);
     for (std::size_t i = 0; i < from.size(); ++i) {
       cv::Vec2f back;
-      const cv::Point2f q = to[i] - origin;
+      const cv::Point2f q = to[i] - back_origin;
       if (!sample(backward.flow, q.x, q.y, back)) continue;
       const float ex = to[i].x + back[0] - from[i].x;
       const float ey = to[i].y + back[1] - from[i].y;
@@ -383,9 +537,9 @@ LocalResult LocalTracker::Impl::track(std::shared_ptr<const flow::Pyramid> pyram
   // the object) the appearance alone may still find it near the prediction, over a wider search.
   const cv::Rect2f flow_box = box_at(c, box.size() * static_cast<float>(scale));
   const double reach = flow_failure == LostReason::Found ? 1.0 : 2.0;
-  Appearance a = match(templ, cur, flow_box, reach);
+  Appearance a = match(templ, view_cur, origin, flow_box, reach);
   if (a.score < params.trust_appearance && !recent.empty()) {
-    const Appearance b = match(recent, cur, flow_box, reach);
+    const Appearance b = match(recent, view_cur, origin, flow_box, reach);
     if (b.score > a.score) a = b;
   }
   r.appearance = a.score;
@@ -415,10 +569,10 @@ LocalResult LocalTracker::Impl::track(std::shared_ptr<const flow::Pyramid> pyram
   ++since_recent;
   if (flow_failure == LostReason::Found && a.score >= params.trust_appearance && r.inliers >= 0.5 &&
       since_recent >= params.template_interval) {
-    cut(cur, box, recent);
+    cut(view_cur, origin, box, recent);
     since_recent = 0;
   }
-  prev = std::move(pyramid);
+  advance();
   r.box = box;
   r.velocity = velocity;
   r.scale = scale;
@@ -481,24 +635,30 @@ const LocalTrackerParams& LocalTracker::params() const {
   return impl_->params;
 }
 
-void LocalTracker::start(std::shared_ptr<const flow::Pyramid> pyramid, const cv::Rect2f& box) {
-  impl_->place(std::move(pyramid), box);
-  cut(*impl_->prev, box, impl_->templ);
-  impl_->recent.release();
-  impl_->since_recent = 0;
+void LocalTracker::start(const LocalFrame& frame, const cv::Rect2f& box) {
+  Impl& s = *impl_;
+  s.place(frame, box);
+  // The appearance from the pyramid of the box and a margin wider than the smoothing: the
+  // values there are the whole frame's.
+  const cv::Rect b = enclosing(box);
+  const cv::Rect around = s.aligned(cv::Rect(b.x - 8, b.y - 8, b.width + 16, b.height + 16));
+  s.build(frame.gray, frame.pyramid, around, s.prev_part);
+  cut(s.prev_part.pyr, around.tl(), box, s.templ);
+  s.recent.release();
+  s.since_recent = 0;
 }
 
-void LocalTracker::restart(std::shared_ptr<const flow::Pyramid> pyramid, const cv::Rect2f& box) {
+void LocalTracker::restart(const LocalFrame& frame, const cv::Rect2f& box) {
   if (impl_->templ.empty()) throw Error("local tracker: restart() before start()");
-  impl_->place(std::move(pyramid), box);
+  impl_->place(frame, box);
 }
 
 bool LocalTracker::started() const {
-  return impl_->prev != nullptr;
+  return !impl_->prev.empty();
 }
 
-LocalResult LocalTracker::track(std::shared_ptr<const flow::Pyramid> pyramid) {
-  return impl_->track(std::move(pyramid));
+LocalResult LocalTracker::track(const LocalFrame& frame) {
+  return impl_->track(frame);
 }
 
 cv::Rect2f LocalTracker::box() const {

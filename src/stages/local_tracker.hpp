@@ -2,11 +2,20 @@
 //
 //   using namespace roiflow;
 //   stages::LocalTracker local;                              // paper defaults: ROI 50, LK 10/3/3
-//   local.start(pyr0, {70, 51, 107, 87});                    // appearance captured from frame 0
-//   for (each next frame's pyramid pyr) {
-//     stages::LocalResult r = local.track(pyr);              // frame t-1 (kept) -> frame t
-//     if (r.lost) { /* global treatment, then local.restart(pyr, found_box) */ }
+//   local.start({gray0}, {70, 51, 107, 87});                 // appearance captured from frame 0
+//   for (each next frame's 8-bit gray image gray) {
+//     stages::LocalResult r = local.track({gray});           // frame t-1 (kept) -> frame t
+//     if (r.lost) { /* global treatment, then local.restart({gray}, found_box) */ }
 //   }
+//
+// Pyramids: the local treatment builds the pyramids (lk.levels, lk.sigma) of only the part of
+// each frame it reads (flow::flow_footprint of the region, the appearance search, a border for
+// the smoothing), on the coarsest level's pixel grid so that they are the whole-frame pyramids'
+// values there. The part built for frame t reaches ahead by the object's velocity, so that the
+// next step finds frame t's part inside it and builds only frame t+1's: one small pyramid per
+// frame instead of a whole one. A whole-frame pyramid given with a frame is used only when the
+// region is the whole frame (whole_frame mode), where it is the same pyramid; so the result
+// never depends on whether one was given.
 //
 // Per frame: the box of frame t-1 and the box the constant-velocity prediction puts in frame t
 // span the local region (at least roi x roi, centred on them). Dense LK runs forward over the
@@ -81,6 +90,14 @@ struct LocalTrackerParams {
   void validate() const;           // throws roiflow::Error naming the bad value
 };
 
+// One frame for the local treatment.
+struct LocalFrame {
+  cv::Mat gray;  // 8-bit single channel
+  // Optional: the whole frame's pyramid, built from `gray` with lk.levels and lk.sigma (a
+  // pipeline builds it in parallel for the whole-frame mode); may be null.
+  std::shared_ptr<const flow::Pyramid> pyramid;
+};
+
 // Why a frame's result is lost (Found when it is not).
 enum class LostReason { Found, FewInliers, LowTexture, Appearance, LeftRegion };
 const char* to_string(LostReason reason);
@@ -110,17 +127,18 @@ class LocalTracker {
 
   const LocalTrackerParams& params() const;
 
-  // Starts on frame `pyramid` (built with params.lk.levels and lk.sigma) at `box`: captures the
-  // target's appearance there and sets the velocity to zero. Throws roiflow::Error when the box
-  // is not finite, has a side below 2 pixels or leaves fewer than 2x2 pixels inside the frame.
-  void start(std::shared_ptr<const flow::Pyramid> pyramid, const cv::Rect2f& box);
+  // Starts on `frame` at `box`: captures the target's appearance there and sets the velocity to
+  // zero. Throws roiflow::Error when the frame is not 8-bit gray, when the box is not finite,
+  // has a side below 2 pixels or leaves fewer than 2x2 pixels inside the frame, or when a
+  // given pyramid is not the frame's.
+  void start(const LocalFrame& frame, const cv::Rect2f& box);
   // Places the object again (after a re-detection) keeping the appearance captured by start().
-  void restart(std::shared_ptr<const flow::Pyramid> pyramid, const cv::Rect2f& box);
+  void restart(const LocalFrame& frame, const cv::Rect2f& box);
   bool started() const;
 
-  // Follows the object from the previous frame to `pyramid` (same size as the previous one,
+  // Follows the object from the previous frame to `frame` (same size as the previous one,
   // else roiflow::Error). Throws roiflow::Error when not started.
-  LocalResult track(std::shared_ptr<const flow::Pyramid> pyramid);
+  LocalResult track(const LocalFrame& frame);
 
   cv::Rect2f box() const;        // the current box (measured or coasted)
   cv::Point2f velocity() const;  // pixels per frame

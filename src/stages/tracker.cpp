@@ -1,6 +1,7 @@
 #include "stages/tracker.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -184,7 +185,19 @@ struct Tracker::Impl {
       : params(p), local(local_params(p), executor_), detector(p.detector), executor(executor_) {}
 
   const flow::Executor* executor;
-  std::shared_ptr<const flow::Pyramid> previous;  // the last frame's pyramid
+  // The last frame's gray image, and its whole pyramid while the target is being acquired
+  // (refine_by_motion needs both frames' whole pyramids; the local treatment builds its own).
+  cv::Mat previous_gray;
+  std::shared_ptr<const flow::Pyramid> previous;
+  std::atomic<bool> wants_pyramid{true};
+
+  // The frame's whole pyramid: the one that came with it, else built now.
+  std::shared_ptr<const flow::Pyramid> whole_pyramid(
+      const cv::Mat& gray, std::shared_ptr<const flow::Pyramid> given) const {
+    if (given) return given;
+    return std::make_shared<const flow::Pyramid>(
+        flow::build_pyramid(gray, params.lk.levels, params.lk.sigma));
+  }
 
   TrackerOutput process(const TrackerInput& frame);
   void acquire(const TrackerInput& frame, TrackerOutput& out);
@@ -210,7 +223,7 @@ void Tracker::Impl::acquire(const TrackerInput& frame, TrackerOutput& out) {
                   " frame");
     }
     detector.set_target(image, b);
-    local.start(frame.pyramid, b);
+    local.start({frame.gray, frame.pyramid}, b);
     if (params.mode == TrackMode::Global) ++activations;
     out.mode =
         params.mode == TrackMode::Global ? TrackRecord::Mode::Global : TrackRecord::Mode::Local;
@@ -221,11 +234,14 @@ void Tracker::Impl::acquire(const TrackerInput& frame, TrackerOutput& out) {
     const std::vector<Detection> objects = detector.moving_objects();
     out.mode = TrackRecord::Mode::Global;
     if (objects.empty()) return;
-    const cv::Rect2f box = previous ? refine_by_motion(*previous, *frame.pyramid, params.lk,
-                                                       objects.front().box, executor)
-                                    : objects.front().box;
+    cv::Rect2f box = objects.front().box;
+    if (!previous_gray.empty()) {
+      previous = whole_pyramid(previous_gray, previous);
+      box = refine_by_motion(*previous, *whole_pyramid(frame.gray, frame.pyramid), params.lk, box,
+                             executor);
+    }
     detector.set_target(image, box);
-    local.start(frame.pyramid, box);
+    local.start({frame.gray, frame.pyramid}, box);
     out.box = box;
   }
   has_target = true;
@@ -234,7 +250,7 @@ void Tracker::Impl::acquire(const TrackerInput& frame, TrackerOutput& out) {
 
 void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out) {
   const cv::Rect2f before = local.box();  // where the object was on the grid of region_flow
-  const LocalResult r = local.track(frame.pyramid);
+  const LocalResult r = local.track({frame.gray, frame.pyramid});
   out.has_target = true;
   out.region = r.region;
   out.region_flow = r.region_flow;
@@ -261,7 +277,7 @@ void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out) {
   const std::optional<Detection> found =
       detector.find_target(image, frame.gray, centre(r.box), by_appearance);
   if (found) {
-    local.restart(frame.pyramid, found->box);
+    local.restart({frame.gray, frame.pyramid}, found->box);
     lost = false;
     out.box = found->box;
     return;
@@ -289,8 +305,9 @@ TrackerOutput Tracker::Impl::process(const TrackerInput& frame) {
     throw Error("tracker: frame " + number_text(static_cast<double>(frame.index)) + ": image is " +
                 size_text(frame.image.size()) + " but gray is " + size_text(size));
   }
-  if (!frame.pyramid || frame.pyramid->size() != size ||
-      frame.pyramid->num_levels() < flow::effective_levels(size, params.lk.levels)) {
+  if (frame.pyramid &&
+      (frame.pyramid->size() != size ||
+       frame.pyramid->num_levels() < flow::effective_levels(size, params.lk.levels))) {
     throw Error("tracker: frame " + number_text(static_cast<double>(frame.index)) +
                 ": the pyramid must be built from gray with pyramid_levels() levels");
   }
@@ -307,7 +324,9 @@ TrackerOutput Tracker::Impl::process(const TrackerInput& frame) {
   } else {
     acquire(frame, out);
   }
-  previous = frame.pyramid;
+  previous_gray = frame.gray;
+  previous = has_target ? nullptr : frame.pyramid;
+  wants_pyramid.store(params.mode == TrackMode::Global || !has_target, std::memory_order_relaxed);
   out.global_activations = activations;
   out.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return out;
@@ -334,6 +353,10 @@ TrackerOutput Tracker::process(const TrackerInput& frame) {
 
 long long Tracker::global_activations() const {
   return impl_->activations;
+}
+
+bool Tracker::wants_pyramid() const {
+  return impl_->wants_pyramid.load(std::memory_order_relaxed);
 }
 
 const char* to_string(TrackMode mode) {

@@ -5,7 +5,8 @@
 //   params.init = cv::Rect2f(70, 51, 107, 87);       // OTB protocol; leave empty to detect
 //   stages::Tracker tracker(params);
 //   while (auto f = source.next()) {
-//     auto pyr = std::make_shared<flow::Pyramid>(flow::build_pyramid(
+//     std::shared_ptr<flow::Pyramid> pyr;                   // optional: see wants_pyramid()
+//     if (tracker.wants_pyramid()) pyr = std::make_shared<flow::Pyramid>(flow::build_pyramid(
 //         f->gray, tracker.pyramid_levels(), tracker.pyramid_sigma()));
 //     stages::TrackerOutput out = tracker.process({f->index, f->image, f->gray, pyr});
 //     if (out.has_target) log.write(to_record(out));
@@ -74,13 +75,15 @@ struct TrackerParams {
   void validate() const;  // throws roiflow::Error naming the bad value
 };
 
-// One frame as the pipeline hands it over. The pyramid is built from `gray` with
-// pyramid_levels() and pyramid_sigma(); the tracker keeps the shared_ptr of the previous frame.
+// One frame as the pipeline hands it over. The pyramid, when given, is the whole frame's, built
+// from `gray` with pyramid_levels() and pyramid_sigma(); it may be null: the tracker then
+// builds what it needs itself. While the local treatment holds the target it needs none (it
+// builds pyramids of its region only); wants_pyramid() tells a pipeline when to build them.
 struct TrackerInput {
   long long index = 0;
-  cv::Mat image;  // as decoded, 8-bit BGR or gray
-  cv::Mat gray;   // 8-bit gray
-  std::shared_ptr<const flow::Pyramid> pyramid;
+  cv::Mat image;                                 // as decoded, 8-bit BGR or gray
+  cv::Mat gray;                                  // 8-bit gray
+  std::shared_ptr<const flow::Pyramid> pyramid;  // optional
 };
 
 struct TrackerOutput {
@@ -115,6 +118,12 @@ class Tracker {
   TrackerOutput process(const TrackerInput& frame);
 
   long long global_activations() const;
+
+  // Whether whole-frame pyramids help the next frames: in global mode and until the target is
+  // known. Without one the tracker builds what it needs, so this only saves a pipeline the
+  // work (the result is the same either way). Thread-safe: a pipeline asks it while process()
+  // runs on another thread.
+  bool wants_pyramid() const;
 
  private:
   struct Impl;
