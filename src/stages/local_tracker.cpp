@@ -342,27 +342,37 @@ Appearance LocalTracker::Impl::match(const cv::Mat& appearance, const flow::Pyra
   const double radius = reach * std::max(3.0, params.search * shorter * f);
   const double box_scale = std::sqrt(static_cast<double>(b.area()) / appearance.size().area());
 
+  // The measured scale searches the whole window; the other scales only a few pixels around its
+  // best position (a few percent of size change moves the best position by less than a pixel),
+  // which keeps the cost of the scales near that of one.
   const int n = 2 * params.scale_steps + 1;
+  const int middle = params.scale_steps;
   std::vector<TemplateMatch> found(n);
   std::vector<double> log_scale(n);
-  std::vector<cv::Rect> windows(n);
+  cv::Rect middle_window;
   int best = -1;
   TemplateSearchParams tp;
   tp.coarse_side = 0;
-  for (int j = 0; j < n; ++j) {
+  for (int k = 0; k < n; ++k) {
+    const int j = k == 0 ? middle : (k <= middle ? k - 1 : k);
     const double ratio = std::pow(1.0 + params.scale_step, j - params.scale_steps);
     tp.scales = {box_scale * ratio * f};
-    const double half_w = 0.5 * appearance.cols * tp.scales[0] + radius;
-    const double half_h = 0.5 * appearance.rows * tp.scales[0] + radius;
+    const bool near_middle = j != middle && found[middle].score > -1;
+    const cv::Point2f at = near_middle ? centre(found[middle].box) : ck;
+    const double pad = near_middle ? 2.0 : radius;
+    const double half_w = 0.5 * appearance.cols * tp.scales[0] + pad;
+    const double half_h = 0.5 * appearance.rows * tp.scales[0] + pad;
     const cv::Rect window =
-        enclosing(cv::Rect2f(static_cast<float>(ck.x - half_w), static_cast<float>(ck.y - half_h),
+        enclosing(cv::Rect2f(static_cast<float>(at.x - half_w), static_cast<float>(at.y - half_h),
                              static_cast<float>(2 * half_w), static_cast<float>(2 * half_h)));
     found[j] = match_template(image, appearance, window, tp);
-    windows[j] = window & cv::Rect(cv::Point(), image.size());
+    if (j == middle) middle_window = window & cv::Rect(cv::Point(), image.size());
     // The size really matched: match_template rounds the scaled template to whole pixels.
     log_scale[j] = found[j].score > -1 ? 0.5 * std::log(static_cast<double>(found[j].box.area()) /
                                                         (appearance.size().area() * f * f))
                                        : 0.0;
+  }
+  for (int j = 0; j < n; ++j) {
     if (found[j].score > -1 && (best < 0 || found[j].score > found[best].score)) best = j;
   }
   Appearance a;
@@ -376,12 +386,21 @@ Appearance LocalTracker::Impl::match(const cv::Mat& appearance, const flow::Pyra
   }
   a.size_ratio = std::exp(log_s) / box_scale;
   const cv::Rect2f& m = found[best].box;
-  const cv::Rect& w = windows[best];
+  // Whether the position search hit its window's edge: judged on the scale that searched the
+  // whole window (the best one when the measured scale found nothing).
+  const bool whole = found[middle].score > -1;
+  const cv::Rect2f& mp = whole ? found[middle].box : m;
+  const cv::Rect w = whole ? middle_window
+                           : enclosing(cv::Rect2f(mp.x - static_cast<float>(radius),
+                                                  mp.y - static_cast<float>(radius),
+                                                  mp.width + 2 * static_cast<float>(radius),
+                                                  mp.height + 2 * static_cast<float>(radius))) &
+                                 cv::Rect(cv::Point(), image.size());
   // Edges of the frame (not of the part) bound the search: a match there is not at the edge.
   a.at_edge =
-      (m.x < w.x + 1.f && w.x + part_k.x > 0) || (m.y < w.y + 1.f && w.y + part_k.y > 0) ||
-      (m.br().x > static_cast<float>(w.br().x) - 1.f && w.br().x + part_k.x < frame_k.width) ||
-      (m.br().y > static_cast<float>(w.br().y) - 1.f && w.br().y + part_k.y < frame_k.height);
+      (mp.x < w.x + 1.f && w.x + part_k.x > 0) || (mp.y < w.y + 1.f && w.y + part_k.y > 0) ||
+      (mp.br().x > static_cast<float>(w.br().x) - 1.f && w.br().x + part_k.x < frame_k.width) ||
+      (mp.br().y > static_cast<float>(w.br().y) - 1.f && w.br().y + part_k.y < frame_k.height);
   const cv::Point2f mk = centre(m) + cv::Point2f(part_k);
   a.centre = cv::Point2f(static_cast<float>((mk.x - 0.5) / f + 0.5),
                          static_cast<float>((mk.y - 0.5) / f + 0.5));

@@ -201,7 +201,7 @@ struct Tracker::Impl {
 
   TrackerOutput process(const TrackerInput& frame);
   void acquire(const TrackerInput& frame, TrackerOutput& out);
-  void follow(const TrackerInput& frame, TrackerOutput& out);
+  void follow(const TrackerInput& frame, TrackerOutput& out, double refresh_weight);
 
   // The background model is only needed to find a target that was not given. `weight`: the
   // frames of video this observation stands for.
@@ -248,9 +248,25 @@ void Tracker::Impl::acquire(const TrackerInput& frame, TrackerOutput& out) {
   out.has_target = true;
 }
 
-void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out) {
+void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double refresh_weight) {
   const cv::Rect2f before = local.box();  // where the object was on the grid of region_flow
-  const LocalResult r = local.track({frame.gray, frame.pyramid});
+  LocalResult r;
+  if (refresh_weight > 0 && executor != nullptr && executor->concurrency() > 1) {
+    // The background refresh (MOG2, milliseconds) and the local treatment touch nothing in
+    // common: beside each other, the refresh leaves the tracker's serial path.
+    executor->for_range(0, 2, 1, [&](int begin, int end) {
+      for (int task = begin; task < end; ++task) {
+        if (task == 0) {
+          observe(frame, refresh_weight);
+        } else {
+          r = local.track({frame.gray, frame.pyramid});
+        }
+      }
+    });
+  } else {
+    if (refresh_weight > 0) observe(frame, refresh_weight);
+    r = local.track({frame.gray, frame.pyramid});
+  }
   out.has_target = true;
   out.region = r.region;
   out.region_flow = r.region_flow;
@@ -311,16 +327,18 @@ TrackerOutput Tracker::Impl::process(const TrackerInput& frame) {
     throw Error("tracker: frame " + number_text(static_cast<double>(frame.index)) +
                 ": the pyramid must be built from gray with pyramid_levels() levels");
   }
+  // While the target is held, the background model is refreshed beside the local treatment.
+  double refresh_weight = 0;
   if (!has_target || lost) {
     observe(frame);
-  } else if (frame.index % params.observe_interval == 0) {
-    observe(frame, params.observe_interval * params.held_learning);
+  } else if (frame.index % params.observe_interval == 0 && !params.init) {
+    refresh_weight = params.observe_interval * params.held_learning;
   }
 
   TrackerOutput out;
   out.index = frame.index;
   if (has_target) {
-    follow(frame, out);
+    follow(frame, out, refresh_weight);
   } else {
     acquire(frame, out);
   }
