@@ -63,6 +63,7 @@ TEST(PyramidTest, LevelsHaveHalvedRoundedUpSizesAndRespectTheMinimumSide) {
       for (int l = 0; l < pyr.num_levels(); ++l) {
         const cv::Mat& level = pyr.levels[l];
         EXPECT_EQ(level.type(), CV_32FC1);
+        EXPECT_EQ(level.size(), level_size(size, l)) << size << " level " << l;
         if (l > 0) {
           const cv::Size prev = pyr.levels[l - 1].size();
           EXPECT_EQ(level.size(), cv::Size((prev.width + 1) / 2, (prev.height + 1) / 2))

@@ -712,10 +712,8 @@ std::vector<cv::Rect> computed_rects(cv::Size size, const LkParams& params,
           : params.iterations * reach + std::max(params.level_median, params.final_median) / 2;
   std::vector<cv::Rect> comp(levels);
   cv::Rect need = region;
-  cv::Size level_size = size;  // pyrDown's: (w + 1) / 2 x (h + 1) / 2
   for (int l = 0; l < levels; ++l) {
-    if (l > 0) level_size = cv::Size((level_size.width + 1) / 2, (level_size.height + 1) / 2);
-    comp[l] = expand(need, margin) & cv::Rect(cv::Point(), level_size);
+    comp[l] = expand(need, margin) & cv::Rect(cv::Point(), level_size(size, l));
     const cv::Rect& c = comp[l];
     need = cv::Rect(cv::Point(c.x / 2, c.y / 2),
                     cv::Point((c.x + c.width - 1) / 2 + 2, (c.y + c.height - 1) / 2 + 2));

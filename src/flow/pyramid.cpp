@@ -13,15 +13,18 @@ int effective_levels(cv::Size size, int requested) {
                 std::to_string(requested));
   }
   int levels = 1;
-  int w = size.width, h = size.height;
   while (levels < requested) {
-    const int nw = (w + 1) / 2, nh = (h + 1) / 2;
-    if (std::min(nw, nh) < kMinLevelSide) break;
-    w = nw;
-    h = nh;
+    const cv::Size next = level_size(size, levels);
+    if (std::min(next.width, next.height) < kMinLevelSide) break;
     ++levels;
   }
   return levels;
+}
+
+cv::Size level_size(cv::Size size, int level) {
+  for (int l = 0; l < level; ++l)
+    size = cv::Size((size.width + 1) / 2, (size.height + 1) / 2);
+  return size;
 }
 
 namespace {

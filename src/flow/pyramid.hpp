@@ -28,6 +28,10 @@ struct Pyramid {
 // asked (1..kMaxLevels; throws roiflow::Error outside that range).
 int effective_levels(cv::Size size, int requested);
 
+// Size of level `level` (>= 0) of a pyramid whose level 0 is `size`: pyrDown's (w+1)/2 x (h+1)/2
+// applied `level` times.
+cv::Size level_size(cv::Size size, int level);
+
 // Accepts CV_8UC1, CV_8UC3 (BGR, converted to gray), CV_16UC1 and CV_32FC1 (taken as [0, 1]).
 // Throws roiflow::Error on an empty image, another type, or sigma < 0 or > 20.
 Pyramid build_pyramid(const cv::Mat& image, int levels, double sigma);

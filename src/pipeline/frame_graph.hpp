@@ -18,15 +18,15 @@
 //                        limiter ◄─ retire ◄─ sinks (one serial node each) ◄─┘ sequencer,
 //                                                                              broadcast
 // Decoding and the pyramids of later frames run ahead of the tracker (different frames and
-// different levels of different frames at once), bounded by the limiter; whole-frame pyramids
-// are built only while the tracker wants them (global mode, target not yet known: the local
-// treatment builds pyramids of its region itself, which costs a fraction of a whole one): at most
+// different levels of different frames at once), bounded by the limiter: at most
 // `max_in_flight` frames exist between the source and their retirement, whatever the length of
-// the stream. The tracker is the serial critical path (its region for frame t+1 comes from its
-// decision at t); it parallelises inside through the TbbExecutor it was given (row tiles of
-// the region). Every sink sees every frame exactly once, in order (the second sequencer: oneTBB
-// does not keep the order between two serial nodes); a frame is retired when all sinks are done
-// with it.
+// the stream. Whole-frame pyramids are built only while the tracker wants them (global mode,
+// target not yet known); otherwise the local treatment builds pyramids of its region itself,
+// a fraction of a whole one. The tracker is the serial critical path (its region for frame t+1
+// comes from its decision at t); it parallelises inside through the TbbExecutor it was given (row
+// tiles of the region). Every sink sees every frame exactly once, in order (the second sequencer:
+// oneTBB does not keep the order between two serial nodes); a frame is retired when all sinks are
+// done with it.
 //
 // Dense mode: the same front end, then a serial node that pairs each frame with the previous
 // one (each pyramid serves two pairs, built once), a flow node that runs several pairs at once

@@ -102,12 +102,7 @@ void cut(const flow::Pyramid& pyr, cv::Point origin, const cv::Rect2f& b, cv::Ma
 // Level `l` of a pyramid part (`rect` of the frame at level 0, origin on the coarsest level's
 // grid) is the rectangle `rect` / 2^l of the frame's level l; sizes as pyrDown makes them.
 cv::Rect level_rect(const cv::Rect& rect, int l) {
-  int w = rect.width, h = rect.height;
-  for (int i = 0; i < l; ++i) {
-    w = (w + 1) / 2;
-    h = (h + 1) / 2;
-  }
-  return {rect.x >> l, rect.y >> l, w, h};
+  return {cv::Point(rect.x >> l, rect.y >> l), flow::level_size(rect.size(), l)};
 }
 
 // A pyramid of part of a frame: `rect` (level-0 pixels) and its levels.
@@ -334,7 +329,7 @@ Appearance LocalTracker::Impl::match(const cv::Mat& appearance, const flow::Pyra
   // `pyr` holds the part of the frame from `origin` (on the grid of every level): level-k
   // pixel i of the part is the frame's level-k pixel i + origin / 2^k.
   const cv::Point part_k(origin.x >> level, origin.y >> level);
-  const cv::Size frame_k = level_rect(frame_rect(), level).size();
+  const cv::Size frame_k = flow::level_size(size, level);
   // Level-k pixel i sits at level-0 pixel i * 2^k: convert through pixel-centre coordinates.
   const cv::Point2f c0 = centre(b);
   const cv::Point2f ck((c0.x - 0.5f) * static_cast<float>(f) + 0.5f - static_cast<float>(part_k.x),

@@ -102,8 +102,7 @@ void ccoeff_normed_direct(const cv::Mat& image, const cv::Mat& templ, cv::Mat& r
   cv::integral(im, sum, sqsum, CV_64F, CV_64F);
   // Template rows padded with zeros to whole vectors, image rows with zeros past the end: each
   // position's dot product is then whole-vector multiply-adds, reduced once per position.
-  const int lanes = kLanes;
-  const int twp = (tw + lanes - 1) / lanes * lanes;
+  const int twp = (tw + kLanes - 1) / kLanes * kLanes;
   cv::Mat tp = cv::Mat::zeros(th, twp, CV_32F);
   cv::Mat ip = cv::Mat::zeros(im.rows, im.cols + twp + 4, CV_32F);
   t.copyTo(tp(cv::Rect(0, 0, tw, th)));
