@@ -6,6 +6,8 @@
 //   BM_Flow/<method>/<W>x<H>/threads:<n>   method: roiflow_paper, roiflow_accurate,
 //                                          dis_ultrafast, dis_fast, dis_medium, farneback
 //   BM_Pyramid/<W>x<H>                     build_pyramid(frame) alone (paper preset), 1 thread
+//   BM_Pretreatment/<roiflow|opencv>/<W>x<H>  level 0 alone (sigma 0.5): roiflow's fused pass vs
+//                                          OpenCV's convertTo + GaussianBlur, 1 thread
 //   BM_Middlebury/<method>/threads:1       with ROIFLOW_MIDDLEBURY=DIR set: every sequence of
 //                                          that Middlebury tree per iteration; counters EPE and
 //                                          AAE are the means over sequences, ms_per_pair the time
@@ -143,6 +145,28 @@ void bm_pyramid(benchmark::State& state, cv::Size size) {
   });
 }
 
+// The pretreatment alone, roiflow's (level 0 of build_pyramid) beside OpenCV's conversion and
+// GaussianBlur, which compute the same: the peer of the fused pass in flow/pyramid.cpp.
+void bm_pretreatment(benchmark::State& state, cv::Size size, bool opencv) {
+  const Scene& scene = scene_of(size);
+  const double sigma = roiflow::flow::LkParams::paper().sigma;
+  roiflow::pipeline::run_with_threads(1, [&] {
+    roiflow::flow::Pyramid pyr;
+    cv::Mat unit, smooth;
+    for (auto _ : state) {
+      if (opencv) {
+        scene.frame0.convertTo(unit, CV_32F, 1.0 / 255.0);
+        cv::GaussianBlur(unit, smooth, cv::Size(), sigma, sigma, cv::BORDER_REPLICATE);
+        benchmark::DoNotOptimize(smooth.data);
+      } else {
+        roiflow::flow::build_pyramid(scene.frame0, 1, sigma, pyr);
+        benchmark::DoNotOptimize(pyr.levels[0].data);
+      }
+    }
+    set_rate(state, size);
+  });
+}
+
 // Real data with ground truth: the Middlebury pairs as scenes (frames, ground-truth flow).
 std::vector<Scene> middlebury_scenes(const std::string& dir) {
   std::vector<Scene> scenes;
@@ -203,6 +227,13 @@ void register_benchmarks() {
     benchmark::RegisterBenchmark(("BM_Pyramid/" + size_name(size)).c_str(), bm_pyramid, size)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
+    for (const bool opencv : {false, true}) {
+      const std::string name =
+          std::string("BM_Pretreatment/") + (opencv ? "opencv" : "roiflow") + "/" + size_name(size);
+      benchmark::RegisterBenchmark(name.c_str(), bm_pretreatment, size, opencv)
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime();
+    }
   }
 }
 

@@ -6,6 +6,7 @@
 #include <limits>
 #include <opencv2/imgproc.hpp>
 #include <string>
+#include <vector>
 
 #include "flow/dense_lk.hpp"
 #include "flow/error.hpp"
@@ -116,6 +117,47 @@ TEST(PyramidTest, AcceptedTypesAreScaledToUnitRange) {
   const Pyramid red = build_pyramid(cv::Mat(size, CV_8UC3, cv::Scalar(0, 0, 255)), 1, 0.0);
   EXPECT_NEAR(blue.levels[0].at<float>(0, 0), 0.114f, 0.005f);
   EXPECT_NEAR(red.levels[0].at<float>(0, 0), 0.299f, 0.005f);
+}
+
+// The pretreatment is computed by roiflow's own fused pass for small kernels; it must be what
+// OpenCV's GaussianBlur (borders replicated) gives on the image in [0, 1], for every input
+// type, for views into a larger image and for images smaller than the kernel.
+TEST(PyramidTest, PretreatmentIsOpenCvsGaussianBlur) {
+  const cv::Mat big = random_image({97, 61}, CV_8UC1, 11);
+  cv::Mat big16, bigf;
+  big.convertTo(big16, CV_16U, 257.0);
+  big.convertTo(bigf, CV_32F, 1.0 / 255.0);
+  struct Case {
+    cv::Mat image;
+    double scale;
+  };
+  const std::vector<Case> cases = {
+      {big, 1.0 / 255.0},
+      {big(cv::Rect(5, 7, 40, 30)), 1.0 / 255.0},
+      {big(cv::Rect(0, 0, 3, 2)), 1.0 / 255.0},
+      {big(cv::Rect(10, 10, 1, 1)), 1.0 / 255.0},
+      {big16(cv::Rect(3, 4, 50, 33)), 1.0 / 65535.0},
+      {bigf(cv::Rect(2, 1, 31, 45)), 1.0},
+  };
+  for (const Case& c : cases) {
+    for (const double sigma : {0.2, 0.5, 0.8, 1.1, 1.6, 3.0}) {
+      SCOPED_TRACE(cv::typeToString(c.image.type()) + " " + std::to_string(c.image.cols) + "x" +
+                   std::to_string(c.image.rows) + " sigma " + std::to_string(sigma));
+      cv::Mat unit, expected;
+      c.image.convertTo(unit, CV_32F, c.scale);
+      cv::GaussianBlur(unit, expected, cv::Size(), sigma, sigma, cv::BORDER_REPLICATE);
+      const Pyramid pyr = build_pyramid(c.image, 1, sigma);
+      ASSERT_EQ(pyr.levels[0].size(), c.image.size());
+      EXPECT_LT(cv::norm(pyr.levels[0], expected, cv::NORM_INF), 1e-6);
+    }
+  }
+  // A part of a frame gets the frame's values wherever the kernel stays inside the part.
+  const Pyramid whole = build_pyramid(big, 1, 0.5);
+  const cv::Rect part(20, 12, 41, 33);
+  const Pyramid piece = build_pyramid(big(part), 1, 0.5);
+  const cv::Rect inner(2, 2, part.width - 4, part.height - 4);
+  EXPECT_EQ(cv::norm(piece.levels[0](inner), whole.levels[0](inner + part.tl()), cv::NORM_INF),
+            0.0);
 }
 
 TEST(PyramidTest, LevelZeroIsTheInputAndCoarserLevelsArePyrDown) {
