@@ -7,6 +7,7 @@
 #endif
 #include <opencv2/imgproc.hpp>
 #include <string>
+#include <vector>
 
 #include "flow/error.hpp"
 
@@ -45,25 +46,28 @@ constexpr int kLanes = 8;
 void dot_windows(const cv::Mat& image, const cv::Mat& t, int x, int y, int count, float* out) {
   const int w = t.cols;
 #if defined(__AVX2__) && defined(__FMA__)
-  __m256 acc[4] = {_mm256_setzero_ps(), _mm256_setzero_ps(), _mm256_setzero_ps(),
-                   _mm256_setzero_ps()};
+  // Four named accumulators, reduced all four at the end: indexing an array of them by the
+  // runtime `count` would keep them in memory instead of registers.
+  __m256 a0 = _mm256_setzero_ps(), a1 = _mm256_setzero_ps();
+  __m256 a2 = _mm256_setzero_ps(), a3 = _mm256_setzero_ps();
   for (int r = 0; r < t.rows; ++r) {
     const float* tr = t.ptr<float>(r);
     const float* in = image.ptr<float>(y + r) + x;
     for (int c = 0; c < w; c += kLanes) {
       const __m256 tv = _mm256_loadu_ps(tr + c);
-      acc[0] = _mm256_fmadd_ps(tv, _mm256_loadu_ps(in + c), acc[0]);
-      acc[1] = _mm256_fmadd_ps(tv, _mm256_loadu_ps(in + c + 1), acc[1]);
-      acc[2] = _mm256_fmadd_ps(tv, _mm256_loadu_ps(in + c + 2), acc[2]);
-      acc[3] = _mm256_fmadd_ps(tv, _mm256_loadu_ps(in + c + 3), acc[3]);
+      a0 = _mm256_fmadd_ps(tv, _mm256_loadu_ps(in + c), a0);
+      a1 = _mm256_fmadd_ps(tv, _mm256_loadu_ps(in + c + 1), a1);
+      a2 = _mm256_fmadd_ps(tv, _mm256_loadu_ps(in + c + 2), a2);
+      a3 = _mm256_fmadd_ps(tv, _mm256_loadu_ps(in + c + 3), a3);
     }
   }
-  for (int k = 0; k < count; ++k) {
-    const __m128 half =
-        _mm_add_ps(_mm256_castps256_ps128(acc[k]), _mm256_extractf128_ps(acc[k], 1));
-    const __m128 pair = _mm_add_ps(half, _mm_movehl_ps(half, half));
-    out[k] = _mm_cvtss_f32(_mm_add_ss(pair, _mm_shuffle_ps(pair, pair, 1)));
-  }
+  // Horizontal sums of the four: two rounds of hadd leave (a0, a1, a2, a3) per 128-bit half.
+  const __m256 h01 = _mm256_hadd_ps(a0, a1), h23 = _mm256_hadd_ps(a2, a3);
+  const __m256 h = _mm256_hadd_ps(h01, h23);
+  alignas(16) float sums[4];
+  _mm_store_ps(sums, _mm_add_ps(_mm256_castps256_ps128(h), _mm256_extractf128_ps(h, 1)));
+  for (int k = 0; k < count; ++k)
+    out[k] = sums[k];
 #else
   float acc[4][kLanes] = {};
   for (int r = 0; r < t.rows; ++r) {
@@ -84,38 +88,79 @@ void dot_windows(const cv::Mat& image, const cv::Mat& t, int x, int y, int count
 
 }  // namespace
 
+namespace {
+
+// Buffers of ccoeff_normed_direct kept per thread: a tracker calls it a few times per frame on
+// a few-kilobyte image, and allocating them afresh each time cost more than the sums (glibc
+// returns the freed top of the heap to the system and faults it back in on the next call).
+struct DirectScratch {
+  std::vector<float> templ, image;  // centred, zero-padded rows
+  std::vector<double> sum, sqsum;   // integral images of the centred image, (rows+1) x (cols+1)
+};
+
+}  // namespace
+
 void ccoeff_normed_direct(const cv::Mat& image, const cv::Mat& templ, cv::Mat& response) {
   if (image.type() != CV_32FC1 || templ.type() != CV_32FC1 || templ.cols > image.cols ||
       templ.rows > image.rows || templ.empty()) {
     throw Error("template search: direct NCC needs a float template no larger than the image");
   }
+  thread_local DirectScratch scratch;
   const int tw = templ.cols, th = templ.rows;
-  const int nx = image.cols - tw + 1, ny = image.rows - th + 1;
+  const int iw = image.cols, ih = image.rows;
+  const int nx = iw - tw + 1, ny = ih - th + 1;
   const double n = static_cast<double>(tw) * th;
   // Both centred on their means: NCC does not change, and the float sums below lose far less
-  // to rounding than they would on raw intensities.
-  cv::Mat t, im;
-  cv::subtract(templ, cv::mean(templ), t, cv::noArray(), CV_32F);
-  cv::subtract(image, cv::mean(image), im, cv::noArray(), CV_32F);
-  const double t_norm2 = t.dot(t);
-  cv::Mat sum, sqsum;
-  cv::integral(im, sum, sqsum, CV_64F, CV_64F);
-  // Template rows padded with zeros to whole vectors, image rows with zeros past the end: each
-  // position's dot product is then whole-vector multiply-adds, reduced once per position.
+  // to rounding than they would on raw intensities. Template rows padded with zeros to whole
+  // vectors, image rows with zeros past the end: each position's dot product is then
+  // whole-vector multiply-adds, reduced once per position.
   const int twp = (tw + kLanes - 1) / kLanes * kLanes;
-  cv::Mat tp = cv::Mat::zeros(th, twp, CV_32F);
-  cv::Mat ip = cv::Mat::zeros(im.rows, im.cols + twp + 4, CV_32F);
-  t.copyTo(tp(cv::Rect(0, 0, tw, th)));
-  im.copyTo(ip(cv::Rect(0, 0, im.cols, im.rows)));
+  const int ipw = iw + twp + 4;
+  scratch.templ.assign(static_cast<std::size_t>(th) * twp, 0.f);
+  scratch.image.assign(static_cast<std::size_t>(ih) * ipw, 0.f);
+  const cv::Mat tp(th, twp, CV_32F, scratch.templ.data());
+  const cv::Mat ip(ih, ipw, CV_32F, scratch.image.data());
+  const auto t_mean = static_cast<float>(cv::mean(templ)[0]);
+  const auto i_mean = static_cast<float>(cv::mean(image)[0]);
+  double t_norm2 = 0;
+  for (int y = 0; y < th; ++y) {
+    const float* src = templ.ptr<float>(y);
+    float* dst = scratch.templ.data() + static_cast<std::size_t>(y) * twp;
+    float acc = 0.f;
+    for (int x = 0; x < tw; ++x) {
+      dst[x] = src[x] - t_mean;
+      acc += dst[x] * dst[x];
+    }
+    t_norm2 += acc;
+  }
+  const std::size_t sw = static_cast<std::size_t>(iw) + 1;
+  scratch.sum.assign(sw * (ih + 1), 0.0);
+  scratch.sqsum.assign(sw * (ih + 1), 0.0);
+  for (int y = 0; y < ih; ++y) {
+    const float* src = image.ptr<float>(y);
+    float* dst = scratch.image.data() + static_cast<std::size_t>(y) * ipw;
+    const double* s_up = scratch.sum.data() + y * sw;
+    const double* q_up = scratch.sqsum.data() + y * sw;
+    double* s_row = scratch.sum.data() + (y + 1) * sw;
+    double* q_row = scratch.sqsum.data() + (y + 1) * sw;
+    double s = 0, q = 0;
+    for (int x = 0; x < iw; ++x) {
+      dst[x] = src[x] - i_mean;
+      s += dst[x];
+      q += static_cast<double>(dst[x]) * dst[x];
+      s_row[x + 1] = s_up[x + 1] + s;
+      q_row[x + 1] = q_up[x + 1] + q;
+    }
+  }
   response.create(ny, nx, CV_32F);
   for (int y = 0; y < ny; ++y) {
     float* out = response.ptr<float>(y);
     for (int x = 0; x < nx; x += 4)
       dot_windows(ip, tp, x, y, std::min(4, nx - x), out + x);
-    const double* s0 = sum.ptr<double>(y);
-    const double* s1 = sum.ptr<double>(y + th);
-    const double* q0 = sqsum.ptr<double>(y);
-    const double* q1 = sqsum.ptr<double>(y + th);
+    const double* s0 = scratch.sum.data() + y * sw;
+    const double* s1 = scratch.sum.data() + (y + th) * sw;
+    const double* q0 = scratch.sqsum.data() + y * sw;
+    const double* q1 = scratch.sqsum.data() + (y + th) * sw;
     for (int x = 0; x < nx; ++x) {
       const double ws = s1[x + tw] - s1[x] - s0[x + tw] + s0[x];
       const double wq = q1[x + tw] - q1[x] - q0[x + tw] + q0[x];
@@ -146,7 +191,7 @@ namespace {
 TemplateMatch match_one(const cv::Mat& image, const cv::Mat& templ, const cv::Rect& region) {
   TemplateMatch best;
   if (region.width < templ.cols || region.height < templ.rows) return best;
-  cv::Mat response;
+  thread_local cv::Mat response;  // reused: see DirectScratch
   const double work = static_cast<double>(region.width - templ.cols + 1) *
                       (region.height - templ.rows + 1) * templ.total();
   if (image.depth() == CV_32F && work <= kDirectLimit) {
