@@ -573,8 +573,13 @@ void iterate_level(const LevelProblem& p, cv::Mat& u, cv::Mat& v, cv::Mat& u_nex
   auto conf_of = [&](int k) {
     return (k + 1 == iterations && confidence) ? confidence->ptr<float>() : nullptr;
   };
-  if (executor.concurrency() == 1) {
-    // One thread: all iterations advance together as a wavefront, iteration k a fixed lag
+  // Stripes pay only when every thread gets a few of them: each costs a task, a fresh window
+  // sum and a pass over the level per iteration instead of the wavefront's one. A tracker's
+  // region of ~100 rows split over two threads (one of them busy decoding) ran slower than the
+  // serial schedule.
+  const int stripes = (h + kStripeRows - 1) / kStripeRows;
+  if (executor.concurrency() == 1 || stripes < 2 * executor.concurrency()) {
+    // Serial: all iterations advance together as a wavefront, iteration k a fixed lag
     // behind k - 1, so each row is read again while it is still in cache instead of once per
     // pass over the level. Iteration k + 1 overwrites a row of k - 1's buffer only after
     // iteration k, the last reader of that row, has moved past it.
@@ -600,7 +605,6 @@ void iterate_level(const LevelProblem& p, cv::Mat& u, cv::Mat& v, cv::Mat& u_nex
       float* un = output(k, 0).ptr<float>();
       float* vn = output(k, 1).ptr<float>();
       float* conf = conf_of(k);
-      const int stripes = (h + kStripeRows - 1) / kStripeRows;
       executor.for_range(0, stripes, 1, [&](int sb, int se) {
         RowIterator stripe(p, uo, vo, 0);
         stripe.run(sb * kStripeRows, std::min(h, se * kStripeRows), un, vn, conf);

@@ -3,6 +3,7 @@
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/partitioner.h>
+#include <oneapi/tbb/task_arena.h>
 
 #include <algorithm>
 #include <cstddef>
@@ -41,9 +42,13 @@ void TbbExecutor::for_range(int begin, int end, int grain,
   // auto_partitioner, not simple_partitioner: stripes cost the same per row, so a few big
   // chunks per thread balance as well as many small ones, and every extra stripe repeats the
   // flow core's per-stripe setup. `grain` stays a floor, not the chunk size.
-  tbb::parallel_for(
-      range, [&body](const tbb::blocked_range<int>& r) { body(r.begin(), r.end()); },
-      tbb::auto_partitioner());
+  // Isolated: while this thread waits for its stripes it must not pick up another node's task
+  // (a frame to decode, a pyramid), which would hold up the serial node it is running for.
+  tbb::this_task_arena::isolate([&] {
+    tbb::parallel_for(
+        range, [&body](const tbb::blocked_range<int>& r) { body(r.begin(), r.end()); },
+        tbb::auto_partitioner());
+  });
 }
 
 int TbbExecutor::concurrency() const {
