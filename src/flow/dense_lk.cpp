@@ -697,32 +697,65 @@ void median_filter(cv::Mat& u, cv::Mat& v, int ksize) {
   cv::medianBlur(v, v, ksize);
 }
 
-// The rectangle each level computes, coarsest last: the region (level 0) or the finer level's
-// rectangle halved (coarser ones), plus the margin its iterations read, clipped to the level.
-std::vector<cv::Rect> computed_rects(cv::Size size, const LkParams& params,
-                                     const FlowOptions& options, const cv::Rect& region) {
-  const int levels = effective_levels(size, params.levels);
+// Which levels LK runs on and the rectangle each level computes (coarsest last).
+struct LevelPlan {
+  int finest = 0;  // LK runs on levels finest .. top - 1
+  int top = 1;
+  // Levels >= finest: the finer level's rectangle halved (the region itself at the finest
+  // level, in its pixels), plus the margin the iterations read, clipped to the level. Levels
+  // below finest: where the finest level's flow is upsampled to, down to the region at level 0.
+  std::vector<cv::Rect> comp;
+};
+
+LevelPlan plan_levels(cv::Size size, const LkParams& params, const FlowOptions& options,
+                      const cv::Rect& region) {
+  if (options.context < -1 || options.context > 1000) {
+    throw Error("flow context must be in -1..1000 pixels, got " + std::to_string(options.context));
+  }
+  if (options.finest_level < 0 || options.finest_level >= kMaxLevels) {
+    throw Error("flow finest level must be in 0.." + std::to_string(kMaxLevels - 1) + ", got " +
+                std::to_string(options.finest_level));
+  }
+  LevelPlan plan;
+  plan.top = flow_pyramid_levels(size, params, options);
+  plan.finest = std::min(options.finest_level, plan.top - 1);
   const Window win = make_window(params.patch, params.derivative == Derivative::HornSchunck);
   // Flow at a pixel after one iteration depends on the previous flow within the window plus
   // the derivative stencil: computing on a margin of this many pixels per iteration makes a
   // region's flow equal the whole frame's flow inside the region (up to rounding).
-  if (options.context < -1 || options.context > 1000) {
-    throw Error("flow context must be in -1..1000 pixels, got " + std::to_string(options.context));
-  }
   const int reach = win.reach() + 2;
   const int margin =
       options.context >= 0
           ? options.context
           : params.iterations * reach + std::max(params.level_median, params.final_median) / 2;
-  std::vector<cv::Rect> comp(levels);
+  plan.comp.resize(plan.top);
   cv::Rect need = region;
-  for (int l = 0; l < levels; ++l) {
-    comp[l] = expand(need, margin) & cv::Rect(cv::Point(), level_size(size, l));
-    const cv::Rect& c = comp[l];
+  for (int l = 0; l < plan.top; ++l) {
+    const cv::Rect level(cv::Point(), level_size(size, l));
+    plan.comp[l] = (l < plan.finest ? need : expand(need, margin)) & level;
+    const cv::Rect& c = plan.comp[l];
     need = cv::Rect(cv::Point(c.x / 2, c.y / 2),
                     cv::Point((c.x + c.width - 1) / 2 + 2, (c.y + c.height - 1) / 2 + 2));
   }
-  return comp;
+  return plan;
+}
+
+// `src` (the finest level's confidence over rectangle `from` of level `level`) sampled at the
+// nearest level pixel for every level-0 pixel of `region`.
+void confidence_to_level0(const cv::Mat& src, const cv::Rect& from, int level,
+                          const cv::Rect& region, cv::Mat& out) {
+  out.create(region.size(), CV_32F);
+  const int half = level > 0 ? 1 << (level - 1) : 0;
+  std::vector<int> column(region.width);
+  for (int x = 0; x < region.width; ++x)
+    column[x] = std::clamp(((region.x + x + half) >> level) - from.x, 0, src.cols - 1);
+  for (int y = 0; y < region.height; ++y) {
+    const int sy = std::clamp(((region.y + y + half) >> level) - from.y, 0, src.rows - 1);
+    const float* in = src.ptr<float>(sy);
+    float* o = out.ptr<float>(y);
+    for (int x = 0; x < region.width; ++x)
+      o[x] = in[column[x]];
+  }
 }
 
 // Dense flow from pyramids with `ws`'s buffers (params already validated).
@@ -730,27 +763,30 @@ void flow_from_pyramids(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkPar
                         FlowResult& result, const FlowOptions& options, Workspace& ws) {
   const cv::Size size = pyr_t.size();
   if (size.empty() || pyr_t1.size() != size) throw Error("pyramids are empty or differ in size");
-  const int levels = effective_levels(size, params.levels);
+  const cv::Rect full(cv::Point(), size);
+  const cv::Rect region = options.region.empty() ? full : (options.region & full);
+  if (region.empty()) throw Error("flow region lies outside the frame");
+  const LevelPlan plan = plan_levels(size, params, options, region);
+  const int levels = plan.top;
   if (pyr_t.num_levels() < levels || pyr_t1.num_levels() < levels) {
     throw Error("pyramid has " + std::to_string(std::min(pyr_t.num_levels(), pyr_t1.num_levels())) +
                 " levels, " + std::to_string(levels) + " needed");
   }
-  const cv::Rect full(cv::Point(), size);
-  const cv::Rect region = options.region.empty() ? full : (options.region & full);
-  if (region.empty()) throw Error("flow region lies outside the frame");
 
   const bool half_grid = params.derivative == Derivative::HornSchunck;
   const Window win = make_window(params.patch, half_grid);
-  const std::vector<cv::Rect> comp = computed_rects(size, params, options, region);
+  const std::vector<cv::Rect>& comp = plan.comp;
 
   const SerialExecutor serial;
   const Executor& exec = options.executor ? *options.executor : serial;
 
   for (auto* mats : {&ws.u, &ws.v, &ws.u_next, &ws.v_next})
     mats->resize(levels);
-  // Level 0 computes the confidence straight into the result when the region is all of it.
+  // The finest level computes the confidence straight into the result when it is level 0 and
+  // the region is all of it.
   const cv::Rect crop(region.tl() - comp[0].tl(), region.size());
-  cv::Mat& confidence = crop.size() == comp[0].size() ? result.confidence : ws.confidence;
+  const bool direct = plan.finest == 0 && crop.size() == comp[0].size();
+  cv::Mat& confidence = direct ? result.confidence : ws.confidence;
   for (int l = levels - 1; l >= 0; --l) {
     const cv::Rect& c = comp[l];
     cv::Mat& u = ws.u[l];
@@ -765,6 +801,7 @@ void flow_from_pyramids(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkPar
       upsample_flow(ws.u[l + 1], comp[l + 1].tl(), c, u);
       upsample_flow(ws.v[l + 1], comp[l + 1].tl(), c, v);
     }
+    if (l < plan.finest) continue;  // below the finest level the flow is only upsampled
     LevelProblem p;
     p.i0 = &pyr_t.levels[l];
     p.i1 = &pyr_t1.levels[l];
@@ -784,17 +821,21 @@ void flow_from_pyramids(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkPar
     p.cy.resize(c.height);
     for (int y = 0; y < c.height; ++y)
       p.cy[y] = window_weight(win, y, c.height);
-    if (l == 0) confidence.create(c.size(), CV_32F);
-    iterate_level(p, u, v, ws.u_next[l], ws.v_next[l], l == 0 ? &confidence : nullptr,
+    const bool finest = l == plan.finest;
+    if (finest) confidence.create(c.size(), CV_32F);
+    iterate_level(p, u, v, ws.u_next[l], ws.v_next[l], finest ? &confidence : nullptr,
                   params.iterations, exec);
-    if (l > 0) median_filter(u, v, params.level_median);
+    median_filter(u, v, finest ? params.final_median : params.level_median);
   }
-  median_filter(ws.u[0], ws.v[0], params.final_median);
 
   const cv::Mat planes[] = {ws.u[0](crop), ws.v[0](crop)};
   result.flow.create(crop.size(), CV_32FC2);
   cv::merge(planes, 2, result.flow);
-  if (&confidence != &result.confidence) confidence(crop).copyTo(result.confidence);
+  if (plan.finest > 0) {
+    confidence_to_level0(confidence, comp[plan.finest], plan.finest, region, result.confidence);
+  } else if (!direct) {
+    confidence(crop).copyTo(result.confidence);
+  }
   result.region = region;
 }
 
@@ -806,12 +847,18 @@ cv::Rect flow_footprint(cv::Size size, const LkParams& params, const FlowOptions
   const cv::Rect region = options.region.empty() ? full : (options.region & full);
   if (region.empty()) throw Error("flow region lies outside the frame");
   cv::Rect out = region;
-  const std::vector<cv::Rect> comp = computed_rects(size, params, options, region);
-  for (std::size_t l = 0; l < comp.size(); ++l) {
+  const LevelPlan plan = plan_levels(size, params, options, region);
+  for (int l = plan.finest; l < plan.top; ++l) {
     const int f = 1 << l;
-    out |= cv::Rect(comp[l].x * f, comp[l].y * f, comp[l].width * f, comp[l].height * f);
+    const cv::Rect& c = plan.comp[l];
+    out |= cv::Rect(c.x * f, c.y * f, c.width * f, c.height * f);
   }
   return out & full;
+}
+
+int flow_pyramid_levels(cv::Size size, const LkParams& params, const FlowOptions& options) {
+  const int finest = std::clamp(options.finest_level, 0, kMaxLevels - 1);
+  return effective_levels(size, std::min(kMaxLevels, params.levels + finest));
 }
 
 LkParams LkParams::paper() {
@@ -896,8 +943,9 @@ void dense_flow(const cv::Mat& frame_t, const cv::Mat& frame_t1, const LkParams&
   }
   WorkspaceLease lease;
   Workspace& ws = *lease;
-  build_pyramid(frame_t, params.levels, params.sigma, ws.pyr_t);
-  build_pyramid(frame_t1, params.levels, params.sigma, ws.pyr_t1);
+  const int levels = flow_pyramid_levels(frame_t.size(), params, options);
+  build_pyramid(frame_t, levels, params.sigma, ws.pyr_t);
+  build_pyramid(frame_t1, levels, params.sigma, ws.pyr_t1);
   flow_from_pyramids(ws.pyr_t, ws.pyr_t1, params, result, options, ws);
 }
 

@@ -78,6 +78,14 @@ struct FlowOptions {
   // flow only near the region's border, which is what a tracker whose region already holds a
   // margin around the object wants. -1..1000.
   int context = -1;
+  // Pyramid level LK stops at (0 = full resolution), 0..5. LK then runs on levels
+  // finest_level .. finest_level + levels - 1 (fewer when the image is too small; the pyramids
+  // must have flow_pyramid_levels() levels) and the flow of the finest one is upsampled
+  // (bilinear, x2 per level) onto the region; the confidence is the finest level's, at the
+  // nearest pixel. A tracker runs LK where its object is a few dozen pixels across: the cost
+  // stays that of a small object however large it is, at a precision of a fraction of that
+  // level's pixel.
+  int finest_level = 0;
 };
 
 struct FlowResult {
@@ -91,7 +99,7 @@ FlowResult dense_flow(const cv::Mat& frame_t, const cv::Mat& frame_t1, const LkP
                       const FlowOptions& options = {});
 
 // Same on pyramids built once per frame (a video frame serves two pairs). The pyramids must
-// have the same size and at least as many levels as effective_levels(size, params.levels).
+// have the same size and at least flow_pyramid_levels(size, params, options) levels.
 FlowResult dense_flow(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkParams& params,
                       const FlowOptions& options = {});
 
@@ -101,6 +109,10 @@ void dense_flow(const cv::Mat& frame_t, const cv::Mat& frame_t1, const LkParams&
                 FlowResult& result, const FlowOptions& options = {});
 void dense_flow(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkParams& params,
                 FlowResult& result, const FlowOptions& options = {});
+
+// How many levels the pyramids given to dense_flow need for `options` at frame size `size`:
+// effective_levels(size, params.levels + finest_level), at most kMaxLevels.
+int flow_pyramid_levels(cv::Size size, const LkParams& params, const FlowOptions& options);
 
 // The level-0 pixels of frame t whose values dense_flow reads for `options` (the rectangles it
 // computes at every level, scaled to level 0; the warps of frame t+1 reach further by the
