@@ -173,6 +173,7 @@ struct TrackCommand {
   std::string input;
   std::string init;
   int roi = 50;
+  double lk_patches = stages::LocalTrackerParams{}.lk_patches;
   std::string mode = "local";
   std::string log;
   RunOutputs out;
@@ -256,6 +257,7 @@ stages::TrackerParams tracker_params(const TrackCommand& cmd) {
   params.lk = lk_params(cmd.lk);
   params.mode = stages::track_mode_from_string(cmd.mode);
   params.roi = cmd.roi;
+  params.local.lk_patches = cmd.lk_patches;
   if (!cmd.init.empty()) params.init = parse_box(cmd.init, "--init");
   try {
     params.validate();
@@ -328,6 +330,8 @@ std::vector<std::string> child_args(const TrackCommand& cmd, const std::string& 
                                 mode,
                                 "--roi",
                                 std::to_string(cmd.roi),
+                                "--lk-patches",
+                                exact(cmd.lk_patches),
                                 "--log",
                                 log,
                                 "--summary",
@@ -736,6 +740,11 @@ void add_track_command(CLI::App& app, TrackCommand& cmd, int& exit_code) {
       ->type_name("X,Y,W,H");
   sub->add_option("--roi", cmd.roi, "side of the local region in pixels")
       ->check(CLI::Range(8, 4096))
+      ->capture_default_str();
+  sub->add_option("--lk-patches", cmd.lk_patches,
+                  "LK runs on the coarsest pyramid level where the object's shorter side still "
+                  "spans this many LK patches, its flow upsampled (0 = always full resolution)")
+      ->check(CLI::Range(0.0, 100.0))
       ->capture_default_str();
   sub->add_option("--mode", cmd.mode,
                   "local: LK in the local region, global fallback; global: the whole frame every "

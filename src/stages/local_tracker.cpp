@@ -111,10 +111,10 @@ struct PartPyramid {
   flow::Pyramid pyr;
 };
 
-// The levels of `part` restricted to `want` (inside part.rect, both origins on the grid):
-// views, no copy.
-void view(const PartPyramid& part, const cv::Rect& want, flow::Pyramid& out) {
-  out.levels.resize(part.pyr.levels.size());
+// The first `levels` levels of `part` restricted to `want` (inside part.rect, both origins on
+// the grid of those levels): views, no copy.
+void view(const PartPyramid& part, const cv::Rect& want, int levels, flow::Pyramid& out) {
+  out.levels.resize(std::min(part.pyr.levels.size(), static_cast<std::size_t>(levels)));
   for (std::size_t l = 0; l < out.levels.size(); ++l) {
     const int li = static_cast<int>(l);
     const cv::Rect have = level_rect(part.rect, li);
@@ -139,6 +139,7 @@ void LocalTrackerParams::validate() const {
   lk.validate();
   check_range("max_points", max_points, 16, 1e6);
   check_range("lk_context", lk_context, -1, 1000);
+  check_range("lk_patches", lk_patches, 0, 100);
   check_range("fb_levels", fb_levels, 1, flow::kMaxLevels);
   if (!(fb_threshold > 0) || !std::isfinite(fb_threshold)) {
     throw Error("local tracker: fb_threshold must be > 0, got " + number_text(fb_threshold));
@@ -186,9 +187,10 @@ const char* to_string(LostReason reason) {
 struct LocalTracker::Impl {
   LocalTrackerParams params;
   const flow::Executor* executor = nullptr;
-  cv::Size size;                                    // of the frames; empty before start()
-  int levels = 1;                                   // effective pyramid levels at that size
-  cv::Mat prev;                                     // frame t-1's gray image
+  cv::Size size;         // of the frames; empty before start()
+  int frame_levels = 1;  // effective levels of a whole-frame pyramid (lk.levels) at that size
+  int levels = 1;        // levels of this step's pyramid parts (more when LK runs coarser)
+  cv::Mat prev;          // frame t-1's gray image
   std::shared_ptr<const flow::Pyramid> prev_whole;  // its whole pyramid (whole_frame mode)
   PartPyramid prev_part;  // the part of frame t-1's pyramid built so far (may be empty)
   PartPyramid next_part;  // buffers for frame t's part
@@ -214,7 +216,8 @@ struct LocalTracker::Impl {
           "local tracker: frame must be 8-bit gray, got " +
           (f.gray.empty() ? std::string("an empty image") : cv::typeToString(f.gray.type())));
     }
-    if (f.pyramid && (f.pyramid->size() != f.gray.size() || f.pyramid->num_levels() < levels)) {
+    if (f.pyramid &&
+        (f.pyramid->size() != f.gray.size() || f.pyramid->num_levels() < frame_levels)) {
       throw Error("local tracker: the pyramid given with a frame is not that frame's");
     }
   }
@@ -236,7 +239,8 @@ struct LocalTracker::Impl {
                   number_text(frame_size.height) + " frame");
     }
     size = frame_size;
-    levels = flow::effective_levels(size, params.lk.levels);
+    frame_levels = flow::effective_levels(size, params.lk.levels);
+    levels = frame_levels;
     check_frame(f);
     prev = f.gray;
     prev_whole = params.whole_frame ? f.pyramid : nullptr;
@@ -273,12 +277,12 @@ struct LocalTracker::Impl {
     return cv::Rect(cv::Point(x0, y0), cv::Point(x1, y1)) & frame;
   }
 
-  // Builds `out` over `rect` of a frame: the whole pyramid when `rect` is the frame and one was
-  // given, else the pyramid of gray(rect).
+  // Builds `out` over `rect` of a frame: the whole pyramid when `rect` is the frame and one with
+  // enough levels was given, else the pyramid of gray(rect).
   void build(const cv::Mat& gray, const std::shared_ptr<const flow::Pyramid>& whole,
              const cv::Rect& rect, PartPyramid& out) const {
     out.rect = rect;
-    if (whole && rect == frame_rect()) {
+    if (whole && rect == frame_rect() && whole->num_levels() >= levels) {
       out.pyr = *whole;
       return;
     }
@@ -286,17 +290,18 @@ struct LocalTracker::Impl {
     for (cv::Mat& level : out.pyr.levels) {
       if (level.u != nullptr && level.u->refcount > 1) level.release();
     }
-    flow::build_pyramid(gray(rect), params.lk.levels, params.lk.sigma, out.pyr);
+    flow::build_pyramid(gray(rect), levels, params.lk.sigma, out.pyr);
   }
 
   // The part of the frame a step reads: LK's footprint over the region, the appearance search
   // around a box that may have moved anywhere in the region, and a border for the smoothing
   // and pyrDown at the part's edges (where the part's values differ from the whole frame's).
-  cv::Rect step_part(const cv::Rect& region) const {
+  cv::Rect step_part(const cv::Rect& region, int lk_level) const {
     if (params.whole_frame) return frame_rect();
     flow::FlowOptions o;
     o.region = region;
     o.context = params.lk_context;
+    o.finest_level = lk_level;
     cv::Rect need = flow::flow_footprint(size, params.lk, o);
     const double side = std::max(box.width, box.height) * kMaxScaleChange;
     const int search = static_cast<int>(
@@ -307,6 +312,23 @@ struct LocalTracker::Impl {
                      region.height + 2 * search);
     const int m = border + motion;
     return aligned(cv::Rect(need.x - m, need.y - m, need.width + 2 * m, need.height + 2 * m));
+  }
+
+  // The finest level where the object's shorter side is at least lk_side (0 in whole_frame
+  // mode), and the levels a step's pyramid parts then need.
+  int lk_level() const {
+    if (params.whole_frame || params.lk_patches <= 0) return 0;
+    const double shorter = std::min(box.width, box.height);
+    const double least = params.lk_patches * params.lk.patch;
+    int level = 0;
+    while (level + 1 < flow::kMaxLevels && shorter / (2 << level) >= least)
+      ++level;
+    return level;
+  }
+  int part_levels(int lk_level) const {
+    flow::FlowOptions o;
+    o.finest_level = lk_level;
+    return flow::flow_pyramid_levels(size, params.lk, o);
   }
 
   Appearance match(const cv::Mat& appearance, const flow::Pyramid& pyr, cv::Point origin,
@@ -451,10 +473,16 @@ LocalResult LocalTracker::Impl::track(const LocalFrame& in) {
 
   // The pyramids of the part of frames t-1 and t this step reads. Frame t's part reaches ahead
   // by the velocity (and a few pixels), where the next step's part of it will most likely be.
-  const cv::Rect part = step_part(r.region);
+  r.level = lk_level();
+  levels = part_levels(r.level);
+  const cv::Rect part = step_part(r.region, r.level);
   view_prev.levels.clear();  // the last step's views: let go so that builds reuse buffers
   view_cur.levels.clear();
-  if ((prev_part.rect & part) != part) build(prev, prev_whole, part, prev_part);
+  // The part of frame t-1 built by the last step serves when it covers this one with as many
+  // levels (a part is on the grid of its coarsest level, so also on that of every finer one).
+  if ((prev_part.rect & part) != part || prev_part.pyr.num_levels() < levels) {
+    build(prev, prev_whole, part, prev_part);
+  }
   cv::Rect ahead = part;
   if (!params.whole_frame) {
     const cv::Point shift(static_cast<int>(std::lround(velocity.x)),
@@ -464,8 +492,8 @@ LocalResult LocalTracker::Impl::track(const LocalFrame& in) {
   }
   build(in.gray, in.pyramid, ahead, next_part);
   built = true;
-  view(prev_part, part, view_prev);
-  view(next_part, part, view_cur);
+  view(prev_part, part, levels, view_prev);
+  view(next_part, part, levels, view_cur);
   const cv::Point origin = part.tl();
 
   flow::FlowOptions opt;
@@ -473,6 +501,7 @@ LocalResult LocalTracker::Impl::track(const LocalFrame& in) {
   opt.initial_motion = velocity;
   opt.executor = executor;
   opt.context = params.lk_context;
+  opt.finest_level = r.level;
   flow::dense_flow(view_prev, view_cur, params.lk, forward, opt);
   r.region_flow = forward.flow.clone();
 
