@@ -366,28 +366,36 @@ TEST(DenseLkTest, PyramidsOfTheFootprintGiveTheRegionsFlow) {
 }
 
 // LK stopped at a coarser level: the flow of that level, upsampled, still follows a smooth
-// motion to a fraction of a pixel, reaches further (one more coarse level), costs a quarter per
-// level skipped, and the region's flow is the whole frame's there; its footprint is what the
-// region's flow reads.
+// motion to a fraction of a pixel at a quarter of the cost per level skipped, and the region's
+// flow is the whole frame's there; its footprint is what the region's flow reads.
 TEST(DenseLkTest, AFinestLevelAboveZeroGivesTheCoarserFlowUpsampled) {
   const Scene s = make_translation(kSize, {7.5f, -4.25f}, 11);
   const LkParams params = LkParams::paper();
   FlowOptions coarse;
   coarse.finest_level = 1;
-  EXPECT_EQ(flow_pyramid_levels(kSize, params, coarse), params.levels + 1);
+  // Levels 1 and 2 of 3; from level 2 on, two levels (2, 3); one level asked, one given.
+  EXPECT_EQ(flow_pyramid_levels(kSize, params, coarse), params.levels);
   EXPECT_EQ(flow_pyramid_levels(kSize, params, {}), params.levels);
+  FlowOptions higher;
+  higher.finest_level = 2;
+  EXPECT_EQ(flow_pyramid_levels(kSize, params, higher), 4);
+  LkParams one = params;
+  one.levels = 1;
+  EXPECT_EQ(flow_pyramid_levels(kSize, one, higher), 3);
   const FlowResult r = dense_flow(s.frame0, s.frame1, params, coarse);
   ASSERT_EQ(r.flow.size(), kSize);
   ASSERT_EQ(r.confidence.size(), kSize);
   const FlowErrors e = interior_errors(r.flow, s.flow);
   EXPECT_LT(e.epe, 0.05);  // measured 0.038 px (0.025 at level 0)
   // The same level-1 problem solved directly on the half-size frames, then doubled.
-  const Pyramid p0 = build_pyramid(s.frame0, params.levels + 1, params.sigma);
-  const Pyramid p1 = build_pyramid(s.frame1, params.levels + 1, params.sigma);
+  const Pyramid p0 = build_pyramid(s.frame0, params.levels, params.sigma);
+  const Pyramid p1 = build_pyramid(s.frame1, params.levels, params.sigma);
   Pyramid h0, h1;
   h0.levels.assign(p0.levels.begin() + 1, p0.levels.end());
   h1.levels.assign(p1.levels.begin() + 1, p1.levels.end());
-  const FlowResult half = dense_flow(h0, h1, params);
+  LkParams two = params;
+  two.levels = params.levels - 1;
+  const FlowResult half = dense_flow(h0, h1, two);
   const cv::Rect inner(40, 40, 80, 60);  // level-1 pixels, away from the border
   for (int y = inner.y; y < inner.y + inner.height; y += 7) {
     for (int x = inner.x; x < inner.x + inner.width; x += 7) {
@@ -405,7 +413,7 @@ TEST(DenseLkTest, AFinestLevelAboveZeroGivesTheCoarserFlowUpsampled) {
   const FlowResult part = dense_flow(s.frame0, s.frame1, params, region);
   const cv::Rect footprint = flow_footprint(kSize, params, region);
   EXPECT_TRUE((footprint & region.region) == region.region);
-  const int align = 1 << params.levels;  // the coarsest of levels + 1
+  const int align = 1 << (params.levels - 1);
   const int x0 = std::max(0, (footprint.x - 16) / align * align);
   const int y0 = std::max(0, (footprint.y - 16) / align * align);
   const cv::Rect crop = cv::Rect(cv::Point(x0, y0), footprint.br() + cv::Point(16, 16)) &

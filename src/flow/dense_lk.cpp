@@ -858,7 +858,8 @@ cv::Rect flow_footprint(cv::Size size, const LkParams& params, const FlowOptions
 
 int flow_pyramid_levels(cv::Size size, const LkParams& params, const FlowOptions& options) {
   const int finest = std::clamp(options.finest_level, 0, kMaxLevels - 1);
-  return effective_levels(size, std::min(kMaxLevels, params.levels + finest));
+  const int top = std::max(params.levels, finest + std::min(params.levels, 2));
+  return effective_levels(size, std::min(kMaxLevels, top));
 }
 
 LkParams LkParams::paper() {

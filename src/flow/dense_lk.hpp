@@ -78,13 +78,16 @@ struct FlowOptions {
   // flow only near the region's border, which is what a tracker whose region already holds a
   // margin around the object wants. -1..1000.
   int context = -1;
-  // Pyramid level LK stops at (0 = full resolution), 0..5. LK then runs on levels
-  // finest_level .. finest_level + levels - 1 (fewer when the image is too small; the pyramids
-  // must have flow_pyramid_levels() levels) and the flow of the finest one is upsampled
-  // (bilinear, x2 per level) onto the region; the confidence is the finest level's, at the
-  // nearest pixel. A tracker runs LK where its object is a few dozen pixels across: the cost
-  // stays that of a small object however large it is, at a precision of a fraction of that
-  // level's pixel.
+  // Pyramid level LK stops at (0 = full resolution), 0..5: the finer levels are skipped. LK
+  // runs on levels finest_level .. levels - 1, keeping at least min(levels, 2) levels (so up to
+  // finest_level + 1 when it is at or above levels - 1; fewer when the image is too small; the
+  // pyramids must have flow_pyramid_levels() levels), and the flow of the finest one is
+  // upsampled (bilinear, x2 per level) onto the region; the confidence is the finest level's,
+  // at the nearest pixel. A tracker runs LK where its object is a few dozen pixels across: the
+  // cost stays that of a small object however large it is, at a precision of a fraction of
+  // that level's pixel, and the coarsest level (the reach for unpredicted motion, in full-
+  // resolution pixels) stays where `levels` put it. A coarser top level instead would grow the
+  // context every level reads, in full-resolution pixels, by 2x.
   int finest_level = 0;
 };
 
@@ -111,7 +114,7 @@ void dense_flow(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkParams& par
                 FlowResult& result, const FlowOptions& options = {});
 
 // How many levels the pyramids given to dense_flow need for `options` at frame size `size`:
-// effective_levels(size, params.levels + finest_level), at most kMaxLevels.
+// effective_levels(size, max(levels, finest_level + min(levels, 2))), at most kMaxLevels.
 int flow_pyramid_levels(cv::Size size, const LkParams& params, const FlowOptions& options);
 
 // The level-0 pixels of frame t whose values dense_flow reads for `options` (the rectangles it

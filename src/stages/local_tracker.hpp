@@ -18,12 +18,11 @@
 // never depends on whether one was given.
 //
 // Object scale: LK (forward and backward) runs on the finest pyramid level where the object's
-// shorter side still spans `lk_patches` LK patches (20 pixels at the paper's 10x10), with
-// lk.levels levels from there up, and its flow is upsampled to full resolution
+// shorter side still spans `lk_patches` LK patches (20 pixels at the paper's 10x10), up to
+// the same coarsest level (at least two levels), and its flow is upsampled to full resolution
 // (flow::FlowOptions::finest_level): a 90-pixel object costs what a 45-pixel one does, at a
-// precision of a fraction of that level's pixel, and the coarser levels reach further for its
-// larger motion. Patches mostly inside the object are what LK needs: on Car4, 1.6 to 3.2
-// patches track alike (AUC 0.866-0.875), 1.2 loses the car.
+// precision of a fraction of that level's pixel. Patches mostly inside the object are what LK
+// needs: on Car4, 1.6 to 3.2 patches track alike (AUC 0.866-0.875), 1.2 loses the car.
 //
 // Per frame: the box of frame t-1 and the box the constant-velocity prediction puts in frame t
 // span the local region (at least roi x roi, centred on them). Dense LK runs forward over the
