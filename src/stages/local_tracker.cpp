@@ -123,6 +123,25 @@ void view(const PartPyramid& part, const cv::Rect& want, int levels, flow::Pyram
   }
 }
 
+// A template at the sizes it was matched at: the object's size changes little from frame to
+// frame, so the same few sizes come back and resizing them again cost a fifth of the check.
+class ScaledTemplates {
+ public:
+  const cv::Mat& at(const cv::Mat& templ, cv::Size size) {
+    for (const auto& [s, m] : sizes_) {
+      if (s == size) return m;
+    }
+    if (sizes_.size() >= kKept) sizes_.clear();
+    sizes_.emplace_back(size, resize_template(templ, size));
+    return sizes_.back().second;
+  }
+  void clear() { sizes_.clear(); }
+
+ private:
+  static constexpr std::size_t kKept = 16;
+  std::vector<std::pair<cv::Size, cv::Mat>> sizes_;
+};
+
 // The best appearance match around a box: centre and size in level-0 pixels, and its NCC.
 struct Appearance {
   double score = -1;
@@ -198,6 +217,7 @@ struct LocalTracker::Impl {
   cv::Point2f velocity;
   cv::Mat templ;   // CV_32FC1 appearance at level 0, cut at the box given to start()
   cv::Mat recent;  // the same, cut at a recent confidently tracked box (empty until then)
+  ScaledTemplates templ_sizes, recent_sizes;
   int since_recent = 0;
 
   // Buffers reused from frame to frame.
@@ -331,8 +351,8 @@ struct LocalTracker::Impl {
     return flow::flow_pyramid_levels(size, params.lk, o);
   }
 
-  Appearance match(const cv::Mat& appearance, const flow::Pyramid& pyr, cv::Point origin,
-                   const cv::Rect2f& b, double reach) const;
+  Appearance match(const cv::Mat& appearance, ScaledTemplates& sizes, const flow::Pyramid& pyr,
+                   cv::Point origin, const cv::Rect2f& b, double reach) const;
   cv::Point2f measure_motion(double& scale);
   LocalResult track(const LocalFrame& frame);
 };
@@ -340,8 +360,9 @@ struct LocalTracker::Impl {
 // The template matched at 2 * scale_steps + 1 scales around the box's size, on the finest level
 // where the object's shorter side is still at least match_side: NCC's cost grows with the
 // template's area, and a few dozen pixels across are plenty to place and size a whole object.
-Appearance LocalTracker::Impl::match(const cv::Mat& appearance, const flow::Pyramid& pyr,
-                                     cv::Point origin, const cv::Rect2f& b, double reach) const {
+Appearance LocalTracker::Impl::match(const cv::Mat& appearance, ScaledTemplates& sizes,
+                                     const flow::Pyramid& pyr, cv::Point origin,
+                                     const cv::Rect2f& b, double reach) const {
   const double shorter = std::min(b.width, b.height);
   int level = 0;
   while (level + 1 < pyr.num_levels() && shorter / (2 << level) >= params.match_side)
@@ -370,19 +391,21 @@ Appearance LocalTracker::Impl::match(const cv::Mat& appearance, const flow::Pyra
   int best = -1;
   TemplateSearchParams tp;
   tp.coarse_side = 0;
+  tp.scales = {1.0};  // the template comes resized
   for (int k = 0; k < n; ++k) {
     const int j = k == 0 ? middle : (k <= middle ? k - 1 : k);
     const double ratio = std::pow(1.0 + params.scale_step, j - params.scale_steps);
-    tp.scales = {box_scale * ratio * f};
+    const double scale = box_scale * ratio * f;
     const bool near_middle = j != middle && found[middle].score > -1;
     const cv::Point2f at = near_middle ? centre(found[middle].box) : ck;
     const double pad = near_middle ? 2.0 : radius;
-    const double half_w = 0.5 * appearance.cols * tp.scales[0] + pad;
-    const double half_h = 0.5 * appearance.rows * tp.scales[0] + pad;
+    const double half_w = 0.5 * appearance.cols * scale + pad;
+    const double half_h = 0.5 * appearance.rows * scale + pad;
     const cv::Rect window =
         enclosing(cv::Rect2f(static_cast<float>(at.x - half_w), static_cast<float>(at.y - half_h),
                              static_cast<float>(2 * half_w), static_cast<float>(2 * half_h)));
-    found[j] = match_template(image, appearance, window, tp);
+    found[j] =
+        match_template(image, sizes.at(appearance, scaled_size(appearance, scale)), window, tp);
     if (j == middle) middle_window = window & cv::Rect(cv::Point(), image.size());
     // The size really matched: match_template rounds the scaled template to whole pixels.
     log_scale[j] = found[j].score > -1 ? 0.5 * std::log(static_cast<double>(found[j].box.area()) /
@@ -580,9 +603,9 @@ LocalResult LocalTracker::Impl::track(const LocalFrame& in) {
   // the object) the appearance alone may still find it near the prediction, over a wider search.
   const cv::Rect2f flow_box = box_at(c, box.size() * static_cast<float>(scale));
   const double reach = flow_failure == LostReason::Found ? 1.0 : 2.0;
-  Appearance a = match(templ, view_cur, origin, flow_box, reach);
+  Appearance a = match(templ, templ_sizes, view_cur, origin, flow_box, reach);
   if (a.score < params.trust_appearance && !recent.empty()) {
-    const Appearance b = match(recent, view_cur, origin, flow_box, reach);
+    const Appearance b = match(recent, recent_sizes, view_cur, origin, flow_box, reach);
     if (b.score > a.score) a = b;
   }
   r.appearance = a.score;
@@ -613,6 +636,7 @@ LocalResult LocalTracker::Impl::track(const LocalFrame& in) {
   if (flow_failure == LostReason::Found && a.score >= params.trust_appearance && r.inliers >= 0.5 &&
       since_recent >= params.template_interval) {
     cut(view_cur, origin, box, recent);
+    recent_sizes.clear();
     since_recent = 0;
   }
   advance();
@@ -687,7 +711,9 @@ void LocalTracker::start(const LocalFrame& frame, const cv::Rect2f& box) {
   const cv::Rect around = s.aligned(cv::Rect(b.x - 8, b.y - 8, b.width + 16, b.height + 16));
   s.build(frame.gray, frame.pyramid, around, s.prev_part);
   cut(s.prev_part.pyr, around.tl(), box, s.templ);
+  s.templ_sizes.clear();
   s.recent.release();
+  s.recent_sizes.clear();
   s.since_recent = 0;
 }
 

@@ -21,14 +21,6 @@ float parabola_peak(float left, float centre, float right) {
   return std::clamp(0.5f * (left - right) / denom, -0.5f, 0.5f);
 }
 
-cv::Mat resized(const cv::Mat& src, cv::Size size) {
-  if (size == src.size()) return src;
-  cv::Mat out;
-  const bool shrink = size.area() < src.size().area();
-  cv::resize(src, out, size, 0, 0, shrink ? cv::INTER_AREA : cv::INTER_LINEAR);
-  return out;
-}
-
 // Above this many multiply-adds (positions x template pixels) OpenCV's matchTemplate, which
 // correlates through the DFT, is faster than the direct sum; below it the DFT's set-up
 // dominates (a 44x25 template over 9x9 positions: 0.075 ms in matchTemplate, 0.022 ms direct;
@@ -185,6 +177,19 @@ void ccoeff_normed_direct(const cv::Mat& image, const cv::Mat& templ, cv::Mat& r
   }
 }
 
+cv::Size scaled_size(const cv::Mat& templ, double scale) {
+  return {std::max(1, static_cast<int>(std::lround(templ.cols * scale))),
+          std::max(1, static_cast<int>(std::lround(templ.rows * scale)))};
+}
+
+cv::Mat resize_template(const cv::Mat& src, cv::Size size) {
+  if (size == src.size()) return src;
+  cv::Mat out;
+  const bool shrink = size.area() < src.size().area();
+  cv::resize(src, out, size, 0, 0, shrink ? cv::INTER_AREA : cv::INTER_LINEAR);
+  return out;
+}
+
 namespace {
 
 // Best full-resolution match of `templ` (already scaled) in `region` of `image`.
@@ -242,10 +247,9 @@ TemplateMatch match_template(const cv::Mat& image, const cv::Mat& templ, const c
   if (region.empty()) return best;
 
   for (double scale : params.scales) {
-    const cv::Size size(std::max(1, static_cast<int>(std::lround(templ.cols * scale))),
-                        std::max(1, static_cast<int>(std::lround(templ.rows * scale))));
+    const cv::Size size = scaled_size(templ, scale);
     if (size.width > region.width || size.height > region.height) continue;
-    const cv::Mat scaled = resized(templ, size);
+    const cv::Mat scaled = resize_template(templ, size);
     const int side = std::min(size.width, size.height);
     TemplateMatch m;
     if (params.coarse_side > 0 && side > params.coarse_side) {
@@ -258,8 +262,8 @@ TemplateMatch match_template(const cv::Mat& image, const cv::Mat& templ, const c
       if (coarse_templ.width > coarse_region.width || coarse_templ.height > coarse_region.height) {
         continue;
       }
-      const cv::Mat small_image = resized(image(region), coarse_region);
-      const TemplateMatch coarse = match_one(small_image, resized(scaled, coarse_templ),
+      const cv::Mat small_image = resize_template(image(region), coarse_region);
+      const TemplateMatch coarse = match_one(small_image, resize_template(scaled, coarse_templ),
                                              cv::Rect(cv::Point(), coarse_region));
       if (coarse.score <= -1) continue;
       const int pad = static_cast<int>(std::ceil(2.0 / f)) + 1;

@@ -37,6 +37,12 @@ struct TemplateSearchParams {
 TemplateMatch match_template(const cv::Mat& image, const cv::Mat& templ, const cv::Rect& search,
                              const TemplateSearchParams& params = {});
 
+// The size match_template gives `templ` at `scale`, and `templ` resized to `size` as it does
+// (area interpolation when shrinking, linear when growing): a caller that matches the same
+// sizes frame after frame keeps them and matches them at scale 1.
+cv::Size scaled_size(const cv::Mat& templ, double scale);
+cv::Mat resize_template(const cv::Mat& templ, cv::Size size);
+
 // OpenCV's TM_CCOEFF_NORMED response (same formula and flat-window rule) by direct summation,
 // which match_template uses for float images when positions x template pixels is small: there
 // it is several times faster than matchTemplate's DFT. Float single-channel inputs, the
