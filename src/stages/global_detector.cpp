@@ -286,11 +286,15 @@ void GlobalDetector::observe(const cv::Mat& image, double weight) {
   Impl& s = *impl_;
   if (s.frame_size.empty()) {
     s.frame_size = image.size();
-    const int width =
-        s.params.work_width > 0 ? std::min(s.params.work_width, image.cols) : image.cols;
-    s.work_size =
-        cv::Size(width, std::max(1, static_cast<int>(std::lround(static_cast<double>(image.rows) *
-                                                                 width / image.cols))));
+    // Shrunk by a whole factor: INTER_AREA then averages k x k blocks, which costs ~0.2 ms at
+    // 768x576; a fractional factor takes its general path (768x576 to 320x240: 3.8 ms, twice
+    // MOG2 itself).
+    const int factor =
+        s.params.work_width > 0
+            ? std::max(1, static_cast<int>(
+                              std::lround(static_cast<double>(image.cols) / s.params.work_width)))
+            : 1;
+    s.work_size = cv::Size(std::max(1, image.cols / factor), std::max(1, image.rows / factor));
     s.to_full = cv::Point2d(static_cast<double>(image.cols) / s.work_size.width,
                             static_cast<double>(image.rows) / s.work_size.height);
   } else if (image.size() != s.frame_size) {

@@ -34,8 +34,9 @@ namespace roiflow::stages {
 struct GlobalDetectorParams {
   int history = 100;       // frames the background model remembers (MOG2 history), >= 2
   int warmup = 3;          // moving_objects() stays empty for this many observed frames
-  int work_width = 320;    // the background model works on frames shrunk to this width
-                           // (never enlarged); 0 = full resolution
+  int work_width = 320;    // the background model works on frames shrunk by the whole factor
+                           // that brings them nearest this width (768 -> 384, 640 -> 320,
+                           // 1920 -> 320; never enlarged); 0 = full resolution
   double min_area = 64;    // smallest object, in full-resolution pixels
   double min_score = 0.5;  // a re-detection below this similarity is no detection, (0, 1)
   std::vector<double> appearance_scales{0.8, 0.9, 1.0, 1.1, 1.25};  // relative to the target's
