@@ -17,10 +17,13 @@
 //
 //   BM_TrackVsDecode/<video>/local/threads:2   five decode-only passes and five local-mode
 //                                           runs, alternating; counters decode_fps, track_fps
-//                                           (medians) and vs_decode (median of the rounds'
-//                                           ratios): the "tracking vs decode-only" bar
+//                                           (medians), vs_decode (median of the rounds'
+//                                           ratios): the "tracking vs decode-only" bar, and
+//                                           decode_cores / track_cores (process CPU time over
+//                                           wall time: how busy the machine was)
 #include <benchmark/benchmark.h>
 
+#include <sys/resource.h>
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
@@ -105,6 +108,14 @@ void bm_track(benchmark::State& state, const std::string& path, stages::TrackMod
   state.counters["global_activations"] = static_cast<double>(activations);
 }
 
+// CPU time of the whole process (every thread, user + system), seconds.
+double process_cpu_s() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec) * 1e-6;
+}
+
 // Frames per second of a decode-only pass and of a local-mode tracking run (2 threads) of the
 // same file.
 double decode_fps(const std::string& path) {
@@ -140,17 +151,29 @@ double median_of(std::vector<double> v) {
 // ratios.
 void bm_track_vs_decode(benchmark::State& state, const std::string& path, int threads) {
   constexpr int kRounds = 5;
-  std::vector<double> decode, track, ratio;
+  std::vector<double> decode, track, ratio, decode_cores, track_cores;
+  // Cores kept busy: process CPU time over wall time of a pass.
+  auto timed = [](auto&& pass, std::vector<double>& cores) {
+    const double cpu0 = process_cpu_s();
+    const auto t0 = std::chrono::steady_clock::now();
+    const double fps = pass();
+    const double wall =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    cores.push_back((process_cpu_s() - cpu0) / wall);
+    return fps;
+  };
   for (auto _ : state) {
     for (int round = 0; round < kRounds; ++round) {
-      decode.push_back(decode_fps(path));
-      track.push_back(tracking_fps(path, threads));
+      decode.push_back(timed([&] { return decode_fps(path); }, decode_cores));
+      track.push_back(timed([&] { return tracking_fps(path, threads); }, track_cores));
       ratio.push_back(track.back() / decode.back());
     }
   }
   state.counters["decode_fps"] = median_of(decode);
   state.counters["track_fps"] = median_of(track);
   state.counters["vs_decode"] = median_of(ratio);
+  state.counters["decode_cores"] = median_of(decode_cores);
+  state.counters["track_cores"] = median_of(track_cores);
 }
 
 void bm_dense(benchmark::State& state, const std::string& path, int threads) {
