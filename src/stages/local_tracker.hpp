@@ -8,14 +8,14 @@
 //     if (r.lost) { /* global treatment, then local.restart({gray}, found_box) */ }
 //   }
 //
-// Pyramids: the local treatment builds the pyramids (lk.levels, lk.sigma) of only the part of
-// each frame it reads (flow::flow_footprint of the region, the appearance search, a border for
-// the smoothing), on the coarsest level's pixel grid so that they are the whole-frame pyramids'
-// values there. The part built for frame t reaches ahead by the object's velocity, so that the
-// next step finds frame t's part inside it and builds only frame t+1's: one small pyramid per
-// frame instead of a whole one. A whole-frame pyramid given with a frame is used only when the
-// region is the whole frame (whole_frame mode), where it is the same pyramid; so the result
-// never depends on whether one was given.
+// Pyramids: the local treatment builds the pyramids (lk.sigma, the levels LK needs at the
+// object's scale) of only the part of each frame it reads (flow::flow_footprint of the region, the
+// appearance search, a border for the smoothing), on the coarsest level's pixel grid so that they
+// are the whole-frame pyramids' values there. The part built for frame t reaches ahead by the
+// object's velocity, so that the next step finds frame t's part inside it and builds only frame
+// t+1's: one small pyramid per frame instead of a whole one. A whole-frame pyramid given with a
+// frame is used only when the region is the whole frame (whole_frame mode), where it is the same
+// pyramid; so the result never depends on whether one was given.
 //
 // Object scale: LK (forward and backward) runs on the finest pyramid level where the object's
 // shorter side still spans `lk_patches` LK patches (20 pixels at the paper's 10x10), up to
