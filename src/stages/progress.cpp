@@ -75,7 +75,7 @@ void Progress::draw(double now, bool final) {
   if (total_ > 0) {
     const double fraction = std::clamp(static_cast<double>(done_) / total_, 0.0, 1.0);
     const int filled = static_cast<int>(fraction * kBarWidth);
-    line = "[";
+    line.push_back('[');  // not line = "[": GCC 12 warns (-Wrestrict) on that under ASan
     line.append(filled, '#');
     line.append(kBarWidth - filled, '.');
     line += "] ";
