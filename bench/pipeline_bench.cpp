@@ -67,15 +67,38 @@ double ms_total(const nlohmann::ordered_json& stats, const char* stage) {
   return stages.contains(stage) ? stages.at(stage).at("ms_total").get<double>() : 0.0;
 }
 
+// One decode-only pass over the file: its frame count.
+long long decode_all(const std::string& path) {
+  stages::VideoSource source(path);
+  long long frames = 0;
+  while (auto f = source.next()) {
+    benchmark::DoNotOptimize(f->gray.data);
+    ++frames;
+  }
+  return frames;
+}
+
+// One tracking run of the file (default params but `mode`), no sinks; `stats` may be null.
+pipeline::RunReport track_all(const std::string& path, stages::TrackMode mode, int threads,
+                              stages::RunStats* stats, long long* activations = nullptr) {
+  stages::VideoSource source(path);
+  pipeline::TbbExecutor tiles;
+  stages::TrackerParams params;
+  params.mode = mode;
+  stages::Tracker tracker(params, &tiles);
+  pipeline::GraphOptions options;
+  options.threads = threads;
+  options.stats = stats;
+  const pipeline::RunReport report =
+      pipeline::run_tracking([&] { return source.next(); }, tracker, {}, options);
+  if (activations) *activations = tracker.global_activations();
+  return report;
+}
+
 void bm_decode(benchmark::State& state, const std::string& path) {
   long long frames = 0;
-  for (auto _ : state) {
-    stages::VideoSource source(path);
-    while (auto f = source.next()) {
-      benchmark::DoNotOptimize(f->gray.data);
-      ++frames;
-    }
-  }
+  for (auto _ : state)
+    frames += decode_all(path);
   state.counters["fps"] =
       benchmark::Counter(static_cast<double>(frames), benchmark::Counter::kIsRate);
 }
@@ -86,21 +109,11 @@ void bm_track(benchmark::State& state, const std::string& path, stages::TrackMod
   double tracker_ms = 0;
   long long activations = 0;
   for (auto _ : state) {
-    stages::VideoSource source(path);
-    pipeline::TbbExecutor tiles;
-    stages::TrackerParams params;
-    params.mode = mode;
-    stages::Tracker tracker(params, &tiles);
     stages::RunStats stats;
-    pipeline::GraphOptions options;
-    options.threads = threads;
-    options.stats = &stats;
-    const pipeline::RunReport report =
-        pipeline::run_tracking([&] { return source.next(); }, tracker, {}, options);
+    const pipeline::RunReport report = track_all(path, mode, threads, &stats, &activations);
     frames += report.frames;
     const auto json = stats.to_json(report.wall_s);
     tracker_ms += ms_total(json, "pyramid") + ms_total(json, "track");
-    activations = tracker.global_activations();
   }
   state.counters["fps"] =
       benchmark::Counter(static_cast<double>(frames), benchmark::Counter::kIsRate);
@@ -120,23 +133,12 @@ double process_cpu_s() {
 // same file.
 double decode_fps(const std::string& path) {
   const auto start = std::chrono::steady_clock::now();
-  stages::VideoSource source(path);
-  long long frames = 0;
-  while (auto f = source.next()) {
-    benchmark::DoNotOptimize(f->gray.data);
-    ++frames;
-  }
+  const long long frames = decode_all(path);
   return frames / std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 double tracking_fps(const std::string& path, int threads) {
-  stages::VideoSource source(path);
-  pipeline::TbbExecutor tiles;
-  stages::Tracker tracker(stages::TrackerParams{}, &tiles);
-  pipeline::GraphOptions options;
-  options.threads = threads;
-  const pipeline::RunReport report =
-      pipeline::run_tracking([&] { return source.next(); }, tracker, {}, options);
+  const pipeline::RunReport report = track_all(path, stages::TrackMode::Local, threads, nullptr);
   return report.frames / report.wall_s;
 }
 

@@ -107,33 +107,12 @@ void smooth_to_unit_float(const cv::Mat& image, const float* k, cv::Mat& out) {
   }
 }
 
-// Level 0: `image` (8-bit, 16-bit or float gray) in [0, 1], smoothed by a Gaussian of `sigma`
-// with the kernel OpenCV's GaussianBlur takes for float images. Up to sigma ~1.1 (radius 4) by
-// the fused pass above: every pyramid of every mode starts with it, and at the paper's sigma 0.5
-// OpenCV's conversion + GaussianBlur take 1.7-1.8x as long (bench/flow_bench BM_Pretreatment,
-// VGA and 720p). Wider kernels by OpenCV; both compute the same up to float rounding (~2e-7).
-void smooth_gray(const cv::Mat& gray, double sigma, cv::Mat& out) {
-  const int ksize = std::max(3, cvRound(sigma * 8 + 1) | 1);
-  const cv::Mat kernel = cv::getGaussianKernel(ksize, sigma, CV_32F);
-  const float* k = kernel.ptr<float>();
-  switch (ksize / 2) {
-    case 1:
-      return smooth_to_unit_float<1>(gray, k, out);
-    case 2:
-      return smooth_to_unit_float<2>(gray, k, out);
-    case 3:
-      return smooth_to_unit_float<3>(gray, k, out);
-    case 4:
-      return smooth_to_unit_float<4>(gray, k, out);
-    default:
-      out.create(gray.size(), CV_32F);
-      for (int y = 0; y < gray.rows; ++y)
-        unit_row(gray, y, out.ptr<float>(y));
-      cv::GaussianBlur(out, out, cv::Size(ksize, ksize), sigma, sigma, cv::BORDER_REPLICATE);
-  }
-}
-
-// Level 0: `image` as float in [0, 1], smoothed when sigma > 0.
+// Level 0: `image` (8-bit gray or BGR, 16-bit or float gray) as float in [0, 1], smoothed by a
+// Gaussian of `sigma` (0 = not at all) with the kernel OpenCV's GaussianBlur takes for float
+// images. Up to sigma ~1.1 (radius 4) by the fused pass above: every pyramid of every mode
+// starts with it, and at the paper's sigma 0.5 OpenCV's conversion + GaussianBlur take
+// 1.7-1.8x as long (bench/flow_bench BM_Pretreatment, VGA and 720p). Wider kernels by OpenCV;
+// both compute the same up to float rounding (~2e-7).
 void base_level(const cv::Mat& image, double sigma, cv::Mat& out) {
   cv::Mat gray;
   switch (image.type()) {
@@ -149,13 +128,27 @@ void base_level(const cv::Mat& image, double sigma, cv::Mat& out) {
       throw Error("image type must be 8-bit gray, 8-bit BGR, 16-bit gray or float gray, got " +
                   cv::typeToString(image.type()));
   }
-  if (sigma > 0.0) {
-    smooth_gray(gray, sigma, out);
-    return;
+  const int ksize = sigma > 0.0 ? std::max(3, cvRound(sigma * 8 + 1) | 1) : 0;
+  if (ksize > 0 && ksize / 2 <= 4) {
+    const cv::Mat kernel = cv::getGaussianKernel(ksize, sigma, CV_32F);
+    const float* k = kernel.ptr<float>();
+    switch (ksize / 2) {
+      case 1:
+        return smooth_to_unit_float<1>(gray, k, out);
+      case 2:
+        return smooth_to_unit_float<2>(gray, k, out);
+      case 3:
+        return smooth_to_unit_float<3>(gray, k, out);
+      default:
+        return smooth_to_unit_float<4>(gray, k, out);
+    }
   }
   out.create(gray.size(), CV_32F);
   for (int y = 0; y < gray.rows; ++y)
     unit_row(gray, y, out.ptr<float>(y));
+  if (ksize > 0) {
+    cv::GaussianBlur(out, out, cv::Size(ksize, ksize), sigma, sigma, cv::BORDER_REPLICATE);
+  }
 }
 
 }  // namespace

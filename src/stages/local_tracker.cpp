@@ -123,8 +123,17 @@ void view(const PartPyramid& part, const cv::Rect& want, int levels, flow::Pyram
   }
 }
 
+// The coarsest of levels 0 .. levels - 1 where a side of `side` level-0 pixels still measures
+// at least `least` pixels.
+int coarsest_level_with(double side, double least, int levels) {
+  int level = 0;
+  while (level + 1 < levels && side / (2 << level) >= least)
+    ++level;
+  return level;
+}
+
 // A template at the sizes it was matched at: the object's size changes little from frame to
-// frame, so the same few sizes come back and resizing them again cost a fifth of the check.
+// frame, so the same few sizes come back and need no resizing again.
 class ScaledTemplates {
  public:
   const cv::Mat& at(const cv::Mat& templ, cv::Size size) {
@@ -334,16 +343,12 @@ struct LocalTracker::Impl {
     return aligned(cv::Rect(need.x - m, need.y - m, need.width + 2 * m, need.height + 2 * m));
   }
 
-  // The finest level where the object's shorter side is at least lk_side (0 in whole_frame
-  // mode), and the levels a step's pyramid parts then need.
+  // The coarsest level where the object's shorter side still spans lk_patches LK patches (0 in
+  // whole_frame mode), and the levels a step's pyramid parts then need.
   int lk_level() const {
     if (params.whole_frame || params.lk_patches <= 0) return 0;
-    const double shorter = std::min(box.width, box.height);
-    const double least = params.lk_patches * params.lk.patch;
-    int level = 0;
-    while (level + 1 < flow::kMaxLevels && shorter / (2 << level) >= least)
-      ++level;
-    return level;
+    return coarsest_level_with(std::min(box.width, box.height), params.lk_patches * params.lk.patch,
+                               flow::kMaxLevels);
   }
   int part_levels(int lk_level) const {
     flow::FlowOptions o;
@@ -364,9 +369,7 @@ Appearance LocalTracker::Impl::match(const cv::Mat& appearance, ScaledTemplates&
                                      const flow::Pyramid& pyr, cv::Point origin,
                                      const cv::Rect2f& b, double reach) const {
   const double shorter = std::min(b.width, b.height);
-  int level = 0;
-  while (level + 1 < pyr.num_levels() && shorter / (2 << level) >= params.match_side)
-    ++level;
+  const int level = coarsest_level_with(shorter, params.match_side, pyr.num_levels());
   const double f = 1.0 / (1 << level);
   const cv::Mat& image = pyr.levels[level];
   // `pyr` holds the part of the frame from `origin` (on the grid of every level): level-k
