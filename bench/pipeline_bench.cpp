@@ -4,7 +4,11 @@
 //   build/release/bench/pipeline_bench                       # the synthetic 640x480 video
 //   ROIFLOW_VIDEOS=../shared/data/video build/release/bench/pipeline_bench
 //
-//   BM_Decode/<video>                       VideoSource alone: the ceiling of any pipeline
+//   BM_Decode/<video>                       VideoSource alone (FFmpeg through VideoDecoder, BGR
+//                                           and gray): the ceiling of any pipeline
+//   BM_DecodeOpenCV/<video>                 cv::VideoCapture::read + cvtColor to gray, what a
+//                                           plain OpenCV program pays (VideoSource before it
+//                                           had its own decoder)
 //   BM_Track/<video>/<local|global>/threads:<n>   run_tracking, no sinks; the target is found
 //                                           by the global treatment (no --init)
 //   BM_Dense/<video>/threads:<n>            run_dense (paper preset), no sinks
@@ -20,7 +24,9 @@
 //                                           (medians), vs_decode (median of the rounds'
 //                                           ratios): the "tracking vs decode-only" bar, and
 //                                           decode_cores / track_cores (process CPU time over
-//                                           wall time: how busy the machine was)
+//                                           wall time: how busy the machine was); also
+//                                           opencv_decode_fps and vs_opencv_decode, the same
+//                                           against BM_DecodeOpenCV's way of decoding
 #include <benchmark/benchmark.h>
 
 #include <sys/resource.h>
@@ -78,6 +84,19 @@ long long decode_all(const std::string& path) {
   return frames;
 }
 
+// One decode-only pass with OpenCV's VideoCapture (BGR, then gray): its frame count.
+long long decode_all_opencv(const std::string& path) {
+  cv::VideoCapture capture(path, cv::CAP_FFMPEG);
+  cv::Mat image, gray;
+  long long frames = 0;
+  while (capture.read(image)) {
+    cv::cvtColor(image, gray, cv::COLOR_BGR2GRAY);
+    benchmark::DoNotOptimize(gray.data);
+    ++frames;
+  }
+  return frames;
+}
+
 // One tracking run of the file (default params but `mode`), no sinks; `stats` may be null.
 pipeline::RunReport track_all(const std::string& path, stages::TrackMode mode, int threads,
                               stages::RunStats* stats, long long* activations = nullptr) {
@@ -95,10 +114,11 @@ pipeline::RunReport track_all(const std::string& path, stages::TrackMode mode, i
   return report;
 }
 
+template <long long (*Decode)(const std::string&)>
 void bm_decode(benchmark::State& state, const std::string& path) {
   long long frames = 0;
   for (auto _ : state)
-    frames += decode_all(path);
+    frames += Decode(path);
   state.counters["fps"] =
       benchmark::Counter(static_cast<double>(frames), benchmark::Counter::kIsRate);
 }
@@ -131,9 +151,10 @@ double process_cpu_s() {
 
 // Frames per second of a decode-only pass and of a local-mode tracking run (2 threads) of the
 // same file.
+template <long long (*Decode)(const std::string&)>
 double decode_fps(const std::string& path) {
   const auto start = std::chrono::steady_clock::now();
-  const long long frames = decode_all(path);
+  const long long frames = Decode(path);
   return frames / std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
@@ -153,7 +174,8 @@ double median_of(std::vector<double> v) {
 // ratios.
 void bm_track_vs_decode(benchmark::State& state, const std::string& path, int threads) {
   constexpr int kRounds = 5;
-  std::vector<double> decode, track, ratio, decode_cores, track_cores;
+  std::vector<double> decode, track, ratio, decode_cores, track_cores, opencv, opencv_ratio,
+      opencv_cores;
   // Cores kept busy: process CPU time over wall time of a pass.
   auto timed = [](auto&& pass, std::vector<double>& cores) {
     const double cpu0 = process_cpu_s();
@@ -166,9 +188,11 @@ void bm_track_vs_decode(benchmark::State& state, const std::string& path, int th
   };
   for (auto _ : state) {
     for (int round = 0; round < kRounds; ++round) {
-      decode.push_back(timed([&] { return decode_fps(path); }, decode_cores));
+      decode.push_back(timed([&] { return decode_fps<decode_all>(path); }, decode_cores));
       track.push_back(timed([&] { return tracking_fps(path, threads); }, track_cores));
+      opencv.push_back(timed([&] { return decode_fps<decode_all_opencv>(path); }, opencv_cores));
       ratio.push_back(track.back() / decode.back());
+      opencv_ratio.push_back(track.back() / opencv.back());
     }
   }
   state.counters["decode_fps"] = median_of(decode);
@@ -176,6 +200,8 @@ void bm_track_vs_decode(benchmark::State& state, const std::string& path, int th
   state.counters["vs_decode"] = median_of(ratio);
   state.counters["decode_cores"] = median_of(decode_cores);
   state.counters["track_cores"] = median_of(track_cores);
+  state.counters["opencv_decode_fps"] = median_of(opencv);
+  state.counters["vs_opencv_decode"] = median_of(opencv_ratio);
 }
 
 void bm_dense(benchmark::State& state, const std::string& path, int threads) {
@@ -193,7 +219,12 @@ void bm_dense(benchmark::State& state, const std::string& path, int threads) {
 }
 
 void register_video(const std::string& name, const std::string& path) {
-  benchmark::RegisterBenchmark(("BM_Decode/" + name).c_str(), bm_decode, path)
+  benchmark::RegisterBenchmark(("BM_Decode/" + name).c_str(), bm_decode<decode_all>, path)
+      ->Unit(benchmark::kMillisecond)
+      ->UseRealTime()
+      ->Iterations(1);
+  benchmark::RegisterBenchmark(("BM_DecodeOpenCV/" + name).c_str(), bm_decode<decode_all_opencv>,
+                               path)
       ->Unit(benchmark::kMillisecond)
       ->UseRealTime()
       ->Iterations(1);

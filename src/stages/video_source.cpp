@@ -21,16 +21,19 @@
 
 #include "flow/error.hpp"
 #include "flow/tracking_scene.hpp"
+#include "stages/video_decoder.hpp"
 
 namespace roiflow::stages {
 
 // One kind of input. read() fills `image` with frame `index` (indices come in order, one
-// after the other) and returns true; or returns false with `failure` empty at a normal end,
-// or naming what went wrong.
+// after the other), and `gray` too when it has it at hand (else VideoSource converts `image`),
+// and returns true; or returns false with `failure` empty at a normal end, or naming what went
+// wrong.
 class VideoSource::Reader {
  public:
   virtual ~Reader() = default;
-  virtual bool read(long long index, cv::Mat& image, double& timestamp_s, std::string& failure) = 0;
+  virtual bool read(long long index, cv::Mat& image, cv::Mat& gray, double& timestamp_s,
+                    std::string& failure) = 0;
   virtual double fps() const = 0;
   virtual long long frame_count() const = 0;  // from index 0; -1 when unknown
   virtual std::string description() const = 0;
@@ -240,7 +243,8 @@ class SequenceReader : public VideoSource::Reader {
            " not read)";
   }
 
-  bool read(long long index, cv::Mat& image, double& timestamp_s, std::string& failure) override {
+  bool read(long long index, cv::Mat& image, cv::Mat&, double& timestamp_s,
+            std::string& failure) override {
     if (index >= static_cast<long long>(paths_.size())) {
       failure = gap_;
       return false;
@@ -278,82 +282,94 @@ class SequenceReader : public VideoSource::Reader {
   std::string gap_;  // why the sequence stops after paths_; empty when it simply ends
 };
 
-class CaptureReader : public VideoSource::Reader {
+class CameraReader : public VideoSource::Reader {
  public:
-  // A video file (camera < 0) or a camera.
-  CaptureReader(const std::string& path, int camera, double default_fps)
-      : label_(camera < 0 ? "video " + quoted(path) : "camera " + std::to_string(camera)),
-        camera_(camera >= 0) {
-    if (camera_) {
-      capture_.open(camera);
-      if (!capture_.isOpened()) throw Error("cannot open " + label_);
-    } else {
-      if (!cv::videoio_registry::hasBackend(cv::CAP_FFMPEG))
-        throw Error("cannot open " + label_ + ": this OpenCV build has no FFmpeg backend");
-      capture_.open(path, cv::CAP_FFMPEG);
-      if (!capture_.isOpened())
-        throw Error("cannot open " + label_ + ": not a video the FFmpeg backend can read");
-    }
-    if (!camera_) {
-      // Checked before the first frame is decoded: a huge frame would be allocated by then.
-      const cv::Size announced(static_cast<int>(capture_.get(cv::CAP_PROP_FRAME_WIDTH)),
-                               static_cast<int>(capture_.get(cv::CAP_PROP_FRAME_HEIGHT)));
-      if (announced.width > 0 && announced.height > 0) check_frame_size(announced, label_);
-    }
+  CameraReader(int camera, double default_fps) : label_("camera " + std::to_string(camera)) {
+    capture_.open(camera);
+    if (!capture_.isOpened()) throw Error("cannot open " + label_);
     const double reported = capture_.get(cv::CAP_PROP_FPS);
     fps_ = std::isfinite(reported) && reported > 0 ? reported : default_fps;
-    const double count = capture_.get(cv::CAP_PROP_FRAME_COUNT);
-    frame_count_ = !camera_ && std::isfinite(count) && count > 0 ? std::llround(count) : -1;
     opened_at_ = std::chrono::steady_clock::now();
   }
 
-  bool read(long long index, cv::Mat& image, double& timestamp_s, std::string& failure) override {
+  bool read(long long, cv::Mat& image, cv::Mat&, double& timestamp_s,
+            std::string& failure) override {
     if (!capture_.read(image) || image.empty()) {
-      failure = end_failure(index);
+      failure = label_ + " stopped delivering frames";
       return false;
     }
-    if (camera_) {
-      timestamp_s =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - opened_at_).count();
-    } else {
-      // Containers without timestamps report 0 (or repeat the last one): fall back to the
-      // frame rate so timestamps always increase.
-      const double pts = capture_.get(cv::CAP_PROP_POS_MSEC) / 1000.0;
-      const bool usable =
-          std::isfinite(pts) && (last_timestamp_ ? pts > *last_timestamp_ : pts >= 0);
-      timestamp_s = usable            ? pts
-                    : last_timestamp_ ? *last_timestamp_ + 1.0 / fps_
-                                      : static_cast<double>(index) / fps_;
+    timestamp_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - opened_at_).count();
+    return true;
+  }
+
+  double fps() const override { return fps_; }
+  long long frame_count() const override { return -1; }
+  std::string description() const override {
+    return label_ + " (" + number_string(fps_) + " fps, " + capture_.getBackendName() + ")";
+  }
+
+ private:
+  std::string label_;
+  cv::VideoCapture capture_;
+  double fps_ = 0;
+  std::chrono::steady_clock::time_point opened_at_;
+};
+
+class VideoFileReader : public VideoSource::Reader {
+ public:
+  VideoFileReader(const std::string& path, double default_fps, int threads)
+      : label_("video " + quoted(path)), decoder_(path, threads) {
+    // Checked before the first frame is decoded: a huge frame would be allocated by then.
+    const cv::Size announced = decoder_.size();
+    if (announced.width > 0 && announced.height > 0) check_frame_size(announced, label_);
+    fps_ = decoder_.fps() > 0 ? decoder_.fps() : default_fps;
+  }
+
+  bool read(long long index, cv::Mat& image, cv::Mat& gray, double& timestamp_s,
+            std::string& failure) override {
+    DecodedFrame frame;
+    std::string error;
+    if (!decoder_.read(frame, error)) {
+      failure = end_failure(index, error);
+      return false;
     }
+    image = frame.bgr;
+    gray = frame.gray;
+    // Containers without timestamps give none (or repeat the last one): fall back to the
+    // frame rate so timestamps always increase.
+    const double pts = frame.timestamp_s;
+    const bool usable = std::isfinite(pts) && (last_timestamp_ ? pts > *last_timestamp_ : pts >= 0);
+    timestamp_s = usable            ? pts
+                  : last_timestamp_ ? *last_timestamp_ + 1.0 / fps_
+                                    : static_cast<double>(index) / fps_;
     last_timestamp_ = timestamp_s;
     return true;
   }
 
   double fps() const override { return fps_; }
-  long long frame_count() const override { return frame_count_; }
+  long long frame_count() const override { return decoder_.frame_count(); }
   std::string description() const override {
+    const long long count = decoder_.frame_count();
     return label_ + " (" + number_string(fps_) + " fps" +
-           (frame_count_ > 0 ? ", " + std::to_string(frame_count_) + " frames" : "") + ", " +
-           capture_.getBackendName() + ")";
+           (count > 0 ? ", " + std::to_string(count) + " frames" : "") + ", FFmpeg " +
+           decoder_.codec_name() + ")";
   }
 
  private:
   std::string label_;
-  bool camera_;
-  cv::VideoCapture capture_;
+  VideoDecoder decoder_;
   double fps_ = 0;
-  long long frame_count_ = -1;
   std::optional<double> last_timestamp_;
-  std::chrono::steady_clock::time_point opened_at_;
 
-  // Why there is no frame `index`: empty at a normal end.
-  std::string end_failure(long long index) const {
-    if (camera_) return label_ + " stopped delivering frames";
+  // Why there is no frame `index`: empty at a normal end. `error`: the decoder's, if any.
+  std::string end_failure(long long index, const std::string& error) const {
+    if (!error.empty()) return label_ + ": " + error;
     // A count estimated from the duration may be a frame or two off: only a clear shortfall
     // is a truncated or corrupt file.
-    if (frame_count_ > 0 && index < frame_count_ - 1 - frame_count_ / 100)
-      return label_ + " ended after " + std::to_string(index) + " of the " +
-             std::to_string(frame_count_) +
+    const long long count = decoder_.frame_count();
+    if (count > 0 && index < count - 1 - count / 100)
+      return label_ + " ended after " + std::to_string(index) + " of the " + std::to_string(count) +
              " frames its container announces (truncated or corrupt file?)";
     return {};
   }
@@ -379,7 +395,7 @@ class SyntheticReader : public VideoSource::Reader {
   SyntheticReader(long long frames, cv::Size size, double fps)
       : frames_(frames), fps_(fps), scene_(scene_params(size)) {}
 
-  bool read(long long index, cv::Mat& image, double& timestamp_s, std::string&) override {
+  bool read(long long index, cv::Mat& image, cv::Mat&, double& timestamp_s, std::string&) override {
     if (index >= frames_) return false;
     // Mirrored so that the vehicle turns back instead of leaping to the start: the only jumps
     // are the scene's own, which the tracker's global treatment has to catch.
@@ -454,10 +470,11 @@ int camera_index(const std::string& input) {
   return static_cast<int>(*number);
 }
 
-std::unique_ptr<VideoSource::Reader> open_reader(const std::string& input, double fps) {
+std::unique_ptr<VideoSource::Reader> open_reader(const std::string& input, double fps,
+                                                 int decode_threads) {
   if (input.empty()) throw Error("no input given: expected a video file, a folder or a camera");
   if (const int camera = camera_index(input); camera >= 0)
-    return std::make_unique<CaptureReader>(input, camera, fps);
+    return std::make_unique<CameraReader>(camera, fps);
   std::error_code ec;
   const fs::file_status status = fs::status(input, ec);
   if (fs::is_directory(status)) {
@@ -470,7 +487,7 @@ std::unique_ptr<VideoSource::Reader> open_reader(const std::string& input, doubl
     throw Error("no image sequence in " + quoted(input) +
                 " or its img/ folder: expected numbered images like 0001.jpg");
   }
-  if (fs::exists(status)) return std::make_unique<CaptureReader>(input, -1, fps);
+  if (fs::exists(status)) return std::make_unique<VideoFileReader>(input, fps, decode_threads);
   if (input.starts_with(kSyntheticPrefix)) return open_synthetic(input, fps);
   if (input.find('%') != std::string::npos) {
     const Pattern pattern = parse_pattern(input);
@@ -509,14 +526,16 @@ VideoSource::VideoSource(const std::string& input, const VideoSourceParams& para
   if (params.start < 0) throw Error("start must be >= 0, got " + std::to_string(params.start));
   if (params.max_frames < 0)
     throw Error("max_frames must be >= 0, got " + std::to_string(params.max_frames));
-  reader_ = open_reader(input, params.fps);
+  if (params.decode_threads < 0)
+    throw Error("decode_threads must be >= 0, got " + std::to_string(params.decode_threads));
+  reader_ = open_reader(input, params.fps, params.decode_threads);
 
-  cv::Mat skipped;
+  cv::Mat skipped, skipped_gray;
   double timestamp_s = 0;
   std::string failure;
   for (long long index = 0; index < params.start; ++index) {
     // Reading (rather than seeking) keeps the frame exact whatever the codec's key frames.
-    if (!reader_->read(index, skipped, timestamp_s, failure))
+    if (!reader_->read(index, skipped, skipped_gray, timestamp_s, failure))
       throw Error("start " + std::to_string(params.start) + " is past the end of " + quoted(input) +
                   ": no frame " + std::to_string(index) +
                   (failure.empty() ? "" : " (" + failure + ")"));
@@ -560,7 +579,8 @@ std::optional<Frame> VideoSource::next() {
 std::optional<Frame> VideoSource::read_frame(long long index, std::string& failure) {
   Frame frame;
   frame.index = index;
-  if (!reader_->read(index, frame.image, frame.timestamp_s, failure)) return std::nullopt;
+  if (!reader_->read(index, frame.image, frame.gray, frame.timestamp_s, failure))
+    return std::nullopt;
   if (frame.image.depth() != CV_8U ||
       (frame.image.channels() != 1 && frame.image.channels() != 3)) {
     failure = "unsupported pixel format (OpenCV type " + std::to_string(frame.image.type()) +
@@ -581,7 +601,7 @@ std::optional<Frame> VideoSource::read_frame(long long index, std::string& failu
   }
   if (frame.image.channels() == 1)
     frame.gray = frame.image;
-  else
+  else if (frame.gray.empty())
     cv::cvtColor(frame.image, frame.gray, cv::COLOR_BGR2GRAY);
   return frame;
 }

@@ -15,7 +15,8 @@
 //     Numbered files (prefix, digits, extension .jpg .jpeg .png .bmp .pgm .ppm .tif .tiff) are
 //     grouped by prefix and extension; the largest group wins. Its frames are the consecutive
 //     run of numbers starting at the smallest one (0001.jpg, 0002.jpg, ... or 1.png, 2.png ...).
-//   - an existing file: a video, read with OpenCV's FFmpeg backend.
+//   - an existing file: a video, decoded with FFmpeg (VideoDecoder: the gray frame is the
+//     decoder's luma plane, the BGR frame one conversion; buffers recycled).
 //   - a path holding one printf conversion (%d, %4d or %04d), like "img/%04d.jpg": an image
 //     sequence made of the files of that folder that match, run as above.
 //   - "synthetic:N" or "synthetic:N:WxH" (when no such file exists): N frames (1..10^9) of
@@ -33,11 +34,10 @@
 //
 // Errors at construction: every one of these throws roiflow::Error naming the input: a path
 // that does not exist, a directory without an image sequence, a pattern nothing matches, a
-// file the FFmpeg backend cannot open, a camera that does not open, bad params, a frame size
-// out of the limits above, a malformed "synthetic:" input, and an input that opens but yields
-// no first frame (empty or corrupt file, `start` past the end). The first
-// frame is decoded in the constructor so that size() is known and a bad input fails before
-// any work starts.
+// file FFmpeg cannot open (or whose video it cannot decode), a camera that does not open, bad
+// params, a frame size out of the limits above, a malformed "synthetic:" input, and an input that
+// opens but yields no first frame (empty or corrupt file, `start` past the end). The first frame is
+// decoded in the constructor so that size() is known and a bad input fails before any work starts.
 //
 // Frames are decoded on demand in next() (only the first ahead of time, so a camera's frames
 // are never a frame late), each into its own buffers: a frame may travel to other threads
@@ -88,6 +88,8 @@ struct VideoSourceParams {
   long long start = 0;       // index of the first frame delivered; a video decodes and drops
                              // the earlier ones (exact whatever the key frames, not instant)
   long long max_frames = 0;  // at most this many frames are delivered; 0 = all
+  int decode_threads = 0;    // a video's FFmpeg decoder threads; 0 = automatic (see
+                             // VideoDecoder); >= 0
 };
 
 struct Frame {
@@ -119,7 +121,7 @@ class VideoSource {
   cv::Size size() const;  // every frame's size: the first frame's
   double fps() const;
   long long frame_count_hint() const;  // frames next() will deliver if all goes well; -1 unknown
-  // e.g. "video 'car.avi' (25 fps, 300 frames, FFMPEG), 640x480"
+  // e.g. "video 'car.avi' (25 fps, 300 frames, FFmpeg mpeg4), 640x480"
   std::string description() const;
   const SourceStatus& status() const;
 

@@ -1,0 +1,164 @@
+#include "stages/video_decoder.hpp"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+#include <string>
+#include <vector>
+
+#include "test_util.hpp"
+
+namespace roiflow::stages {
+namespace {
+
+using roiflow::test::error_message;
+
+const cv::Size kSize(160, 120);
+constexpr int kFrames = 12;
+
+// Colourful texture (every channel varies, within 30..220 so that no colour is clipped in the
+// codec's round trip, where the BGR frame's gray would part from the luma) with a light square
+// moving 3 px a frame.
+cv::Mat scene(int k) {
+  cv::Mat image(kSize, CV_8UC3);
+  for (int y = 0; y < kSize.height; ++y)
+    for (int x = 0; x < kSize.width; ++x)
+      image.at<cv::Vec3b>(y, x) = cv::Vec3b(static_cast<uchar>(30 + (x * 7 + y * 3) % 150),
+                                            static_cast<uchar>(30 + (x * 2 + y * 5) % 150),
+                                            static_cast<uchar>(30 + (y * 11) % 150));
+  cv::rectangle(image, cv::Rect(10 + 3 * k, 40, 20, 20), cv::Scalar(220, 215, 210), cv::FILLED);
+  return image;
+}
+
+struct Codec {
+  const char* name;
+  const char* file;
+  int fourcc;
+};
+
+class VideoDecoderTest : public roiflow::test::TempDirTest,
+                         public ::testing::WithParamInterface<Codec> {
+ protected:
+  std::string write_video() {
+    const Codec& codec = GetParam();
+    const std::string file = path(codec.file);
+    cv::VideoWriter writer(file, cv::CAP_FFMPEG, codec.fourcc, 25, kSize);
+    EXPECT_TRUE(writer.isOpened()) << "cannot write " << codec.name;
+    for (int k = 0; k < kFrames; ++k)
+      writer.write(scene(k));
+    return file;
+  }
+};
+
+// MJPG decodes to full-range YUV (yuvj420p), MPEG-4 to video range (yuv420p): the gray frame
+// is the luma plane as it is in the first case and expanded in the second; in both it must be
+// the BGR frame's own gray, within rounding.
+TEST_P(VideoDecoderTest, GrayIsTheBgrFramesGrayAndFramesComeInOrder) {
+  VideoDecoder video(write_video());
+  EXPECT_EQ(video.size(), kSize);
+  EXPECT_DOUBLE_EQ(video.fps(), 25);
+  EXPECT_EQ(video.frame_count(), kFrames);
+  EXPECT_EQ(video.threads(), 1);  // small frames: one decoder thread
+  DecodedFrame f;
+  std::string failure;
+  int n = 0;
+  double last_timestamp = -1;
+  while (video.read(f, failure)) {
+    ASSERT_EQ(f.bgr.type(), CV_8UC3);
+    ASSERT_EQ(f.gray.type(), CV_8UC1);
+    ASSERT_EQ(f.gray.size(), kSize);
+    // Near the BGR frame's gray (which differs by swscale's rounding, up to one level biased
+    // at full range, and where interpolated chroma overshoots and a colour is clipped), and at
+    // least as near the original picture's gray as that one.
+    cv::Mat from_bgr, original;
+    cv::cvtColor(f.bgr, from_bgr, cv::COLOR_BGR2GRAY);
+    cv::cvtColor(scene(n), original, cv::COLOR_BGR2GRAY);
+    const auto mean_diff = [](const cv::Mat& a, const cv::Mat& b) {
+      cv::Mat diff;
+      cv::absdiff(a, b, diff);
+      return cv::mean(diff)[0];
+    };
+    EXPECT_LT(mean_diff(f.gray, from_bgr), 2.0) << GetParam().name << " frame " << n;
+    EXPECT_LE(mean_diff(f.gray, original), mean_diff(from_bgr, original) + 0.2)
+        << GetParam().name << " frame " << n << ": " << mean_diff(f.gray, original) << " vs "
+        << mean_diff(from_bgr, original);
+    // The square (bright in gray) moved 3 px a frame.
+    const cv::Moments m = cv::moments(f.gray(cv::Rect(0, 40, kSize.width, 20)) > 200, true);
+    ASSERT_GT(m.m00, 0);
+    EXPECT_NEAR(m.m10 / m.m00, 10 + 3 * n + 9.5, 1.5) << "frame " << n;
+    EXPECT_NEAR(f.timestamp_s, n / 25.0, 0.5 / 25);
+    EXPECT_GT(f.timestamp_s, last_timestamp);
+    last_timestamp = f.timestamp_s;
+    ++n;
+  }
+  EXPECT_EQ(failure, "");
+  EXPECT_EQ(n, kFrames);
+  EXPECT_FALSE(video.read(f, failure));
+}
+
+// Buffers come back once nobody holds them, and a frame still held is never written over.
+TEST_P(VideoDecoderTest, BuffersAreRecycledButNeverWhileHeld) {
+  VideoDecoder video(write_video());
+  std::string failure;
+  DecodedFrame held;
+  ASSERT_TRUE(video.read(held, failure));
+  const cv::Mat held_bgr = held.bgr.clone();
+  const cv::Mat held_gray = held.gray.clone();
+  std::vector<const uchar*> seen;
+  for (int k = 1; k < kFrames; ++k) {
+    DecodedFrame f;
+    ASSERT_TRUE(video.read(f, failure)) << failure;
+    EXPECT_NE(f.bgr.data, held.bgr.data);
+    EXPECT_NE(f.gray.data, held.gray.data);
+    seen.push_back(f.gray.data);
+  }
+  EXPECT_EQ(cv::norm(held.bgr, held_bgr, cv::NORM_INF), 0);
+  EXPECT_EQ(cv::norm(held.gray, held_gray, cv::NORM_INF), 0);
+  // Each frame was let go before the next was read: one buffer served them all.
+  for (const uchar* data : seen)
+    EXPECT_EQ(data, seen.front());
+}
+
+std::string codec_name(const ::testing::TestParamInfo<Codec>& codec) {
+  return codec.param.name == std::string("MJPG") ? "Mjpg" : "Mpeg4";
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Codecs, VideoDecoderTest,
+    ::testing::Values(Codec{"MJPG", "clip.avi", cv::VideoWriter::fourcc('M', 'J', 'P', 'G')},
+                      Codec{"MPEG-4", "clip.mp4", cv::VideoWriter::fourcc('m', 'p', '4', 'v')}),
+    codec_name);
+
+class VideoDecoderErrorTest : public roiflow::test::TempDirTest {};
+
+TEST_F(VideoDecoderErrorTest, BadInputsThrowNamingTheFile) {
+  const std::string missing = path("missing.mp4");
+  EXPECT_NE(error_message([&] { VideoDecoder v(missing); }).find(missing), std::string::npos);
+  const std::string text = path("notes.mp4");
+  std::ofstream(text) << "not a video at all\n";
+  EXPECT_NE(error_message([&] { VideoDecoder v(text); }).find(text), std::string::npos);
+  const std::string message = error_message([&] { VideoDecoder v(text, -1); });
+  EXPECT_NE(message.find("-1"), std::string::npos) << message;
+}
+
+TEST_F(VideoDecoderErrorTest, AskedThreadsAreUsed) {
+  const std::string file = path("clip.mp4");
+  {
+    cv::VideoWriter writer(file, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('m', 'p', '4', 'v'), 25,
+                           kSize);
+    for (int k = 0; k < 4; ++k)
+      writer.write(scene(k));
+  }
+  VideoDecoder video(file, 2);
+  EXPECT_EQ(video.threads(), 2);
+  DecodedFrame f;
+  std::string failure;
+  int n = 0;
+  while (video.read(f, failure))
+    ++n;
+  EXPECT_EQ(n, 4) << failure;
+}
+
+}  // namespace
+}  // namespace roiflow::stages
