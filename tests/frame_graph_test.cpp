@@ -16,6 +16,8 @@
 
 #include "flow/dense_lk.hpp"
 #include "flow/synthetic.hpp"
+#include "flow/tracking_scene.hpp"
+#include "pipeline/tbb_executor.hpp"
 #include "test_util.hpp"
 
 namespace roiflow::pipeline {
@@ -183,6 +185,58 @@ TEST_P(FrameGraphThreads, DenseDeliversEveryPairInOrderAndEqualsTheSerialFlow) {
   for (double d : max_difference)
     EXPECT_EQ(d, 0.0);
   EXPECT_EQ(report.frames, kFrames);
+}
+
+// The real tracker without a given target (so the background model is refreshed beside the
+// frames while the target is held, through the executor's start) and with a jump it must find
+// again: every box, lost flag, mode and activation count equals those of the serial tracker.
+TEST_P(FrameGraphThreads, TheTrackerGivesTheSerialResult) {
+  flow::TrackingSceneParams scene_params;
+  scene_params.size = {320, 240};
+  scene_params.object = {40.f, 26.f};
+  scene_params.jump = 24.0;
+  scene_params.frames = 90;
+  scene_params.jump_frame = 60;
+  const flow::TrackingScene scene(scene_params);
+  auto frame = [&](int i) {
+    stages::Frame f;
+    f.index = i;
+    f.image = scene.render(i);
+    cv::cvtColor(f.image, f.gray, cv::COLOR_BGR2GRAY);
+    return f;
+  };
+  stages::TrackerParams params;
+  params.observe_interval = 4;  // many refreshes in a short run
+
+  std::vector<stages::TrackerOutput> serial;
+  {
+    stages::Tracker tracker(params);
+    for (int i = 0; i < scene.frames(); ++i) {
+      const stages::Frame f = frame(i);
+      serial.push_back(tracker.process({f.index, f.image, f.gray, nullptr}));
+    }
+  }
+  ASSERT_GE(serial.back().global_activations, 2);  // detection, and the jump
+
+  int next = 0;
+  TbbExecutor tiles;
+  stages::Tracker tracker(params, &tiles);
+  std::vector<stages::TrackerOutput> piped;
+  GraphOptions options;
+  options.threads = GetParam();
+  run_tracking(
+      [&]() -> std::optional<stages::Frame> {
+        if (next >= scene.frames()) return std::nullopt;
+        return frame(next++);
+      },
+      tracker, {{"collect", [&](const TrackedFrame& f) { piped.push_back(*f.output); }}}, options);
+  ASSERT_EQ(piped.size(), serial.size());
+  for (std::size_t i = 0; i < serial.size(); ++i) {
+    EXPECT_EQ(piped[i].box, serial[i].box) << "frame " << i;
+    EXPECT_EQ(piped[i].lost, serial[i].lost) << "frame " << i;
+    EXPECT_EQ(piped[i].mode, serial[i].mode) << "frame " << i;
+    EXPECT_EQ(piped[i].global_activations, serial[i].global_activations) << "frame " << i;
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Threads, FrameGraphThreads, ::testing::Values(1, 2, 4));

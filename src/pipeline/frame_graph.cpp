@@ -312,6 +312,7 @@ RunReport run_tracking(const FrameSource& source, stages::Tracker& tracker,
   step.sigma = tracker.pyramid_sigma();
   step.process = [&tracker](const stages::TrackerInput& in) { return tracker.process(in); };
   step.wants_pyramid = [&tracker] { return tracker.wants_pyramid(); };
+  step.drain = [&tracker] { tracker.finish_background_work(); };
   return run_tracking(source, step, sinks, options);
 }
 
@@ -354,7 +355,19 @@ RunReport run_tracking(const FrameSource& source, const TrackStep& step,
     }
     tf::make_edge(tf::output_port<0>(retire), front.retire_port());
 
-    return finish(g, run, front, start);
+    if (!step.drain) return finish(g, run, front, start);
+    RunReport report;
+    try {
+      report = finish(g, run, front, start);
+    } catch (...) {
+      try {
+        step.drain();
+      } catch (...) {  // NOLINT(bugprone-empty-catch): the first error is the one reported
+      }
+      throw;
+    }
+    step.drain();
+    return report;
   });
 }
 

@@ -102,6 +102,10 @@ struct TrackStep {
   // Optional, thread-safe: false when the step does not want whole-frame pyramids for the next
   // frames (Tracker::wants_pyramid); those frames then come with a null pyramid. Empty: always.
   std::function<bool()> wants_pyramid;
+  // Optional: waits for work `process` left running on the graph's threads
+  // (Tracker::finish_background_work); called once the graph is done, before its threads go,
+  // also when the run ends by an exception.
+  std::function<void()> drain;
 };
 RunReport run_tracking(const FrameSource& source, const TrackStep& step,
                        const std::vector<TrackSink>& sinks, const GraphOptions& options = {});

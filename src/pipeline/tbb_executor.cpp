@@ -4,6 +4,7 @@
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/partitioner.h>
 #include <oneapi/tbb/task_arena.h>
+#include <oneapi/tbb/task_group.h>
 
 #include <algorithm>
 #include <cstddef>
@@ -15,6 +16,23 @@
 namespace roiflow::pipeline {
 
 namespace {
+
+class TbbJob final : public flow::Job {
+ public:
+  explicit TbbJob(std::function<void()> job) {
+    tbb::this_task_arena::enqueue(group_.defer(std::move(job)));
+  }
+  ~TbbJob() noexcept override {
+    try {
+      group_.wait();
+    } catch (...) {  // NOLINT(bugprone-empty-catch): the owner did not ask for the outcome
+    }
+  }
+  void wait() override { group_.wait(); }
+
+ private:
+  tbb::task_group group_;
+};
 
 int validated_thread_count(int threads) {
   if (threads < 1 || threads > kMaxThreads) {
@@ -53,6 +71,11 @@ void TbbExecutor::for_range(int begin, int end, int grain,
 
 int TbbExecutor::concurrency() const {
   return tbb::this_task_arena::max_concurrency();
+}
+
+std::unique_ptr<flow::Job> TbbExecutor::start(std::function<void()> job) const {
+  if (tbb::this_task_arena::max_concurrency() == 1) return flow::Executor::start(std::move(job));
+  return std::make_unique<TbbJob>(std::move(job));
 }
 
 ThreadScope::ThreadScope(int threads)

@@ -34,6 +34,10 @@ class TbbExecutor final : public flow::Executor {
                  const std::function<void(int, int)>& body) const override;
   // The caller's arena's thread count.
   int concurrency() const override;
+  // With more than one thread: `job` as a task of the caller's arena (a tbb::task_group), which
+  // an idle thread takes while the caller goes on. The job must be waited for before that
+  // arena ends (run_tracking waits for the tracker's through TrackStep::drain).
+  std::unique_ptr<flow::Job> start(std::function<void()> job) const override;
 };
 
 // Holds OpenCV at `threads` threads and owns an arena of `threads` slots while it lives.

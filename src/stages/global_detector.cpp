@@ -132,9 +132,12 @@ struct GlobalDetector::Impl {
   cv::Size work_size;
   cv::Point2d to_full{1, 1};  // full-resolution pixels per model pixel, in x and y
   long long observed = 0;
-  cv::Mat foreground;  // cleaned mask of the last observed frame, at work_size
-  cv::Mat fg_raw;      // MOG2's output, kept to reuse its buffer
-  cv::Mat small;       // the shrunk frame, kept to reuse its buffer
+  cv::Mat fg_raw;  // MOG2's output for the last observed frame, at work_size
+  // fg_raw cleaned by morphology, made when first asked for: the tracker's refreshes of the
+  // model while it holds the target never look at it (a third of a refresh's time).
+  mutable cv::Mat foreground;
+  mutable bool foreground_stale = false;
+  cv::Mat small;  // the shrunk frame, kept to reuse its buffer
   cv::Mat open_kernel, close_kernel;
 
   cv::Mat templ;  // gray appearance captured by set_target
@@ -172,9 +175,21 @@ struct GlobalDetector::Impl {
     return out;
   }
 
+  // The cleaned foreground mask of the last observed frame (empty before any).
+  const cv::Mat& clean_foreground() const {
+    if (foreground_stale) {
+      // Opening removes isolated noise pixels; closing joins the pieces of one object that
+      // the model split where the object looks like the background.
+      cv::morphologyEx(fg_raw, foreground, cv::MORPH_OPEN, open_kernel);
+      cv::morphologyEx(foreground, foreground, cv::MORPH_CLOSE, close_kernel);
+      foreground_stale = false;
+    }
+    return foreground;
+  }
+
   std::vector<Blob> blobs() const {
     std::vector<Blob> out;
-    if (observed <= params.warmup || foreground.empty()) return out;
+    if (observed <= params.warmup || clean_foreground().empty()) return out;
     std::vector<std::vector<cv::Point>> contours;
     // CHAIN_APPROX_NONE: every edge pixel, so the barycentre is that of the
     // edge, not of the corners of a polygon.
@@ -311,10 +326,7 @@ void GlobalDetector::observe(const cv::Mat& image, double weight) {
   // slow object into the background within a few frames. At 1/history the first frame's
   // content fades from the background in about a tenth of the history.
   s.model->apply(*input, s.fg_raw, std::min(1.0, weight / s.params.history));
-  // Opening removes isolated noise pixels; closing joins the pieces of one
-  // object that the model split where the object looks like the background.
-  cv::morphologyEx(s.fg_raw, s.foreground, cv::MORPH_OPEN, s.open_kernel);
-  cv::morphologyEx(s.foreground, s.foreground, cv::MORPH_CLOSE, s.close_kernel);
+  s.foreground_stale = true;
   ++s.observed;
 }
 
@@ -349,7 +361,7 @@ void GlobalDetector::set_target(const cv::Mat& image, const cv::Rect2f& box) {
   Signature sig;
   sig.channels = image.channels();
   cv::Mat mask;
-  if (!s.foreground.empty() && image.size() == s.frame_size) {
+  if (!s.clean_foreground().empty() && image.size() == s.frame_size) {
     double best_overlap = 0;
     for (const Blob& b : s.blobs()) {
       const double overlap = (cv::Rect2f(r) & b.detection.box).area();

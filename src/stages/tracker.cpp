@@ -190,6 +190,16 @@ struct Tracker::Impl {
   cv::Mat previous_gray;
   std::shared_ptr<const flow::Pyramid> previous;
   std::atomic<bool> wants_pyramid{true};
+  // The background refresh running beside the frames while the target is held (it touches
+  // the detector's background model only; set_target_size, the one detector call a held frame
+  // makes, touches the target's size). Waited for before the model is used again. Declared
+  // last: destroyed (so waited for) before everything it touches.
+  std::unique_ptr<flow::Job> refresh;
+
+  // Waits for the background refresh; rethrows what it threw.
+  void finish_refresh() {
+    if (refresh) std::exchange(refresh, nullptr)->wait();
+  }
 
   // The frame's whole pyramid: the one that came with it, else built now.
   std::shared_ptr<const flow::Pyramid> whole_pyramid(
@@ -206,13 +216,31 @@ struct Tracker::Impl {
   // The background model is only needed to find a target that was not given. `weight`: the
   // frames of video this observation stands for.
   void observe(const TrackerInput& frame, double weight = 1.0) {
+    finish_refresh();
     if (params.init || observed_index == frame.index) return;
     detector.observe(frame.image.empty() ? frame.gray : frame.image, weight);
     observed_index = frame.index;
   }
+
+  // observe() beside the frames that follow (executor's start; at once without an executor):
+  // a refresh of the model while the target is held is not needed before the target is lost.
+  void start_refresh(const TrackerInput& frame, double weight) {
+    finish_refresh();
+    if (params.init || observed_index == frame.index) return;
+    observed_index = frame.index;
+    const cv::Mat image = frame.image.empty() ? frame.gray : frame.image;  // kept alive by the job
+    GlobalDetector* model = &detector;
+    const auto job = [model, image, weight] { model->observe(image, weight); };
+    if (executor != nullptr) {
+      refresh = executor->start(job);
+    } else {
+      job();
+    }
+  }
 };
 
 void Tracker::Impl::acquire(const TrackerInput& frame, TrackerOutput& out) {
+  finish_refresh();
   const cv::Mat& image = frame.image.empty() ? frame.gray : frame.image;
   if (params.init) {
     const cv::Rect2f& b = *params.init;
@@ -250,23 +278,8 @@ void Tracker::Impl::acquire(const TrackerInput& frame, TrackerOutput& out) {
 
 void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double refresh_weight) {
   const cv::Rect2f before = local.box();  // where the object was on the grid of region_flow
-  LocalResult r;
-  if (refresh_weight > 0 && executor != nullptr && executor->concurrency() > 1) {
-    // The background refresh (MOG2, milliseconds) and the local treatment touch nothing in
-    // common: beside each other, the refresh leaves the tracker's serial path.
-    executor->for_range(0, 2, 1, [&](int begin, int end) {
-      for (int task = begin; task < end; ++task) {
-        if (task == 0) {
-          observe(frame, refresh_weight);
-        } else {
-          r = local.track({frame.gray, frame.pyramid});
-        }
-      }
-    });
-  } else {
-    if (refresh_weight > 0) observe(frame, refresh_weight);
-    r = local.track({frame.gray, frame.pyramid});
-  }
+  if (refresh_weight > 0) start_refresh(frame, refresh_weight);
+  const LocalResult r = local.track({frame.gray, frame.pyramid});
   out.has_target = true;
   out.region = r.region;
   out.region_flow = r.region_flow;
@@ -285,6 +298,7 @@ void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double
     return;
   }
   // Lost: the global treatment searches the whole frame; until it succeeds the box coasts.
+  finish_refresh();
   if (!global_mode) ++activations;
   out.mode = TrackRecord::Mode::Global;
   const cv::Mat& image = frame.image.empty() ? frame.gray : frame.image;
@@ -327,7 +341,7 @@ TrackerOutput Tracker::Impl::process(const TrackerInput& frame) {
     throw Error("tracker: frame " + number_text(static_cast<double>(frame.index)) +
                 ": the pyramid must be built from gray with pyramid_levels() levels");
   }
-  // While the target is held, the background model is refreshed beside the local treatment.
+  // While the target is held, the background model is refreshed beside the frames.
   double refresh_weight = 0;
   if (!has_target || lost) {
     observe(frame);
@@ -375,6 +389,10 @@ long long Tracker::global_activations() const {
 
 bool Tracker::wants_pyramid() const {
   return impl_->wants_pyramid.load(std::memory_order_relaxed);
+}
+
+void Tracker::finish_background_work() {
+  impl_->finish_refresh();
 }
 
 const char* to_string(TrackMode mode) {

@@ -103,8 +103,9 @@ struct TrackerOutput {
 
 class Tracker {
  public:
-  // `executor` splits LK over row tiles of the region (nullptr = serial); it must outlive the
-  // tracker. Throws roiflow::Error on bad params.
+  // `executor` splits LK over row tiles of the region and runs the background model's refresh
+  // beside the frames while the target is held (nullptr = everything serial, at once); it must
+  // outlive the tracker. The results never depend on it. Throws roiflow::Error on bad params.
   explicit Tracker(const TrackerParams& params, const flow::Executor* executor = nullptr);
   ~Tracker();
   Tracker(Tracker&&) noexcept;
@@ -124,6 +125,11 @@ class Tracker {
   // work (the result is the same either way). Thread-safe: a pipeline asks it while process()
   // runs on another thread.
   bool wants_pyramid() const;
+
+  // Waits for the work the tracker started beside its frames through the executor (the
+  // background refresh) and rethrows what it threw. A pipeline calls it before the threads that
+  // run that work go away; the destructor waits too.
+  void finish_background_work();
 
  private:
   struct Impl;
