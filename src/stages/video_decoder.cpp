@@ -68,7 +68,8 @@ struct VideoDecoder::Impl {
   AVPacket* packet = nullptr;
   AVFrame* frame = nullptr;
   SwsContext* sws = nullptr;
-  int sws_format = -1;  // the source format `sws` was made for
+  int sws_format = -1;  // the source format and size `sws` was made for
+  cv::Size sws_size;
   bool sws_full_range = false;
   int stream = -1;
   double fps = 0;
@@ -135,6 +136,12 @@ struct VideoDecoder::Impl {
 
   void convert(DecodedFrame& out) {
     const int w = frame->width, h = frame->height;
+    // Checked before any buffer of the new size is allocated (a damaged stream may claim any).
+    if (!sws_size.empty() && sws_size != cv::Size(w, h)) {
+      throw Error("video '" + path + "': the frame size changed from " +
+                  std::to_string(sws_size.width) + "x" + std::to_string(sws_size.height) + " to " +
+                  std::to_string(w) + "x" + std::to_string(h) + " mid-stream");
+    }
     const auto source_format = static_cast<AVPixelFormat>(frame->format);
     const bool full = full_range(*frame);
     if (sws == nullptr || sws_format != frame->format || sws_full_range != full) {
@@ -158,6 +165,7 @@ struct VideoDecoder::Impl {
                                  brightness, contrast, saturation);
       }
       sws_format = frame->format;
+      sws_size = cv::Size(w, h);
       sws_full_range = full;
     }
     out.bgr = take(bgr_pool, h, w, CV_8UC3);

@@ -24,8 +24,9 @@
 //
 // Errors: the constructor throws roiflow::Error naming the file when it cannot be opened, has
 // no video stream or no decoder for it, or announces a frame size outside the frame limits.
-// read() returns false at the end of the stream (failure empty) or when a packet cannot be read
-// or decoded (failure names the FFmpeg error): the caller stops there. The FFmpeg log level
+// read() returns false at the end of the stream (failure empty) or when a packet cannot be
+// decoded, a frame cannot be converted, or the frame size changes mid-stream (failure says
+// which): the caller stops there. The FFmpeg log level
 // follows OPENCV_FFMPEG_LOGLEVEL when it is set, as with OpenCV's own FFmpeg backend.
 #pragma once
 
