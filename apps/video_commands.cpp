@@ -168,6 +168,22 @@ Ending ending(const pipeline::RunReport& report, const stages::SourceStatus* sta
 // ---------------------------------------------------------------------------------------------
 // roiflow track
 
+// What to read of the input and how far ahead (track and dense).
+struct SourceOptions {
+  long long start = 0;
+  long long max_frames = 0;
+  int in_flight = 0;
+  int decode_threads = 0;
+
+  stages::VideoSourceParams params() const {
+    stages::VideoSourceParams p;
+    p.start = start;
+    p.max_frames = max_frames;
+    p.decode_threads = decode_threads;
+    return p;
+  }
+};
+
 struct TrackCommand {
   LkOptions lk;
   std::string input;
@@ -177,9 +193,7 @@ struct TrackCommand {
   std::string mode = "local";
   std::string log;
   RunOutputs out;
-  long long start = 0;
-  long long max_frames = 0;
-  int in_flight = 0;
+  SourceOptions source;
   bool compare = false;  // --compare: local and global mode side by side
   std::string compare_out = "out/compare";
   std::vector<int> compare_patches;
@@ -338,11 +352,13 @@ std::vector<std::string> child_args(const TrackCommand& cmd, const std::string& 
                                 summary,
                                 "--no-progress",
                                 "--start",
-                                std::to_string(cmd.start),
+                                std::to_string(cmd.source.start),
                                 "--max-frames",
-                                std::to_string(cmd.max_frames),
+                                std::to_string(cmd.source.max_frames),
                                 "--in-flight",
-                                std::to_string(cmd.in_flight),
+                                std::to_string(cmd.source.in_flight),
+                                "--decode-threads",
+                                std::to_string(cmd.source.decode_threads),
                                 "--preset",
                                 cmd.lk.preset,
                                 "--patch",
@@ -500,10 +516,7 @@ int run_compare(const TrackCommand& cmd) {
   }
   {
     // Opened here only to check the input and --init before any child starts.
-    stages::VideoSourceParams source_params;
-    source_params.start = cmd.start;
-    source_params.max_frames = cmd.max_frames;
-    stages::VideoSource source(cmd.input, source_params);
+    stages::VideoSource source(cmd.input, cmd.source.params());
     if (params.init) {
       const cv::Rect2f frame(0.f, 0.f, static_cast<float>(source.size().width),
                              static_cast<float>(source.size().height));
@@ -601,7 +614,7 @@ int run_compare(const TrackCommand& cmd) {
     stages::PlotSeries s;
     s.name = r->mode + " (median " + fixed(r->ms_median, 2) + " ms)";
     for (std::size_t i = 0; i < r->ms.size(); ++i) {
-      s.x.push_back(static_cast<double>(cmd.start + static_cast<long long>(i) + 1));
+      s.x.push_back(static_cast<double>(cmd.source.start + static_cast<long long>(i) + 1));
       s.y.push_back(r->ms[i]);
     }
     s.markers = r->ms.size() <= 60;
@@ -684,16 +697,13 @@ int run_track(const TrackCommand& cmd) {
   if (!cmd.out.video.empty()) check_output_path(cmd.out.video, "--out");
   if (!cmd.out.summary.empty()) check_summary_path(cmd.out.summary);
 
-  stages::VideoSourceParams source_params;
-  source_params.start = cmd.start;
-  source_params.max_frames = cmd.max_frames;
-  stages::VideoSource source(cmd.input, source_params);
+  stages::VideoSource source(cmd.input, cmd.source.params());
   check_init_inside(params, cmd.init, source.size());
 
   SignalScope signals;
   TrackRun run =
       track([&] { return source.next(); }, source.size(), source.fps(), source.frame_count_hint(),
-            params, cmd.lk.threads, cmd.in_flight, cmd.log, cmd.out, false);
+            params, cmd.lk.threads, cmd.source.in_flight, cmd.log, cmd.out, false);
   const Ending end = ending(run.report, &source.status());
   run.summary["input"] = source.description();
   run.summary["status"] = end.message.empty() ? source.status().message : end.message;
@@ -717,14 +727,18 @@ void add_run_outputs(CLI::App& sub, RunOutputs& out, const std::string& video_he
   sub.add_flag("!--no-progress", out.progress, "no progress bar on the terminal");
 }
 
-void add_source_options(CLI::App& sub, long long& start, long long& max_frames, int& in_flight) {
-  sub.add_option("--start", start, "index of the first frame to read")
+void add_source_options(CLI::App& sub, SourceOptions& source) {
+  sub.add_option("--start", source.start, "index of the first frame to read")
       ->check(CLI::Range(0LL, std::numeric_limits<long long>::max()));
-  sub.add_option("--max-frames", max_frames, "stop after this many frames (0 = all)")
+  sub.add_option("--max-frames", source.max_frames, "stop after this many frames (0 = all)")
       ->check(CLI::Range(0LL, std::numeric_limits<long long>::max()));
-  sub.add_option("--in-flight", in_flight,
+  sub.add_option("--in-flight", source.in_flight,
                  "frames decoded ahead and in the pipeline at most (0 = 2 x threads + 2)")
       ->check(CLI::Range(0, 1024));
+  sub.add_option("--decode-threads", source.decode_threads,
+                 "a video's FFmpeg decoder threads (0 = one up to 1280x720, where more cost more "
+                 "than they give, else FFmpeg's choice)")
+      ->check(CLI::Range(0, 64));
 }
 
 void add_track_command(CLI::App& app, TrackCommand& cmd, int& exit_code) {
@@ -754,7 +768,7 @@ void add_track_command(CLI::App& app, TrackCommand& cmd, int& exit_code) {
   sub->add_option("--log", cmd.log, "track log, one line per frame (.csv or .json)")
       ->type_name("FILE");
   add_run_outputs(*sub, cmd.out, "annotated video (.mp4 .avi .mkv .mov) or a folder of PNG frames");
-  add_source_options(*sub, cmd.start, cmd.max_frames, cmd.in_flight);
+  add_source_options(*sub, cmd.source);
   cmd.lk.threads = default_threads();
   add_lk_options(*sub, cmd.lk);
   const std::string group = "Run-time comparison (paper Sec. 4.4-4.5, Fig. 12)";
@@ -790,9 +804,7 @@ struct DenseCommand {
   std::string input;
   RunOutputs out;
   double max_motion = 0;
-  long long start = 0;
-  long long max_frames = 0;
-  int in_flight = 0;
+  SourceOptions source;
 };
 
 int run_dense(const DenseCommand& cmd) {
@@ -801,10 +813,7 @@ int run_dense(const DenseCommand& cmd) {
   check_output_path(cmd.out.video, "--out");
   if (!cmd.out.summary.empty()) check_summary_path(cmd.out.summary);
 
-  stages::VideoSourceParams source_params;
-  source_params.start = cmd.start;
-  source_params.max_frames = cmd.max_frames;
-  stages::VideoSource source(cmd.input, source_params);
+  stages::VideoSource source(cmd.input, cmd.source.params());
   stages::VideoSink video(cmd.out.video, source.fps(), source.size());
   const long long hint = source.frame_count_hint();
   stages::Progress progress(std::cerr, hint > 1 ? hint - 1 : hint,
@@ -814,7 +823,7 @@ int run_dense(const DenseCommand& cmd) {
   stages::RunStats stats;
   pipeline::GraphOptions options;
   options.threads = cmd.lk.threads;
-  options.max_in_flight = cmd.in_flight;
+  options.max_in_flight = cmd.source.in_flight;
   options.cancel = &g_cancel;
   options.stats = &stats;
   const float max_motion = static_cast<float>(cmd.max_motion > 0 ? cmd.max_motion : -1.0);
@@ -868,7 +877,7 @@ void add_dense_command(CLI::App& app, DenseCommand& cmd, int& exit_code) {
   sub->add_option("--max-motion", cmd.max_motion,
                   "flow magnitude (px) at full colour saturation; 0 = each pair's own maximum")
       ->check(CLI::Range(0.0, 1e4));
-  add_source_options(*sub, cmd.start, cmd.max_frames, cmd.in_flight);
+  add_source_options(*sub, cmd.source);
   cmd.lk.threads = default_threads();
   add_lk_options(*sub, cmd.lk);
   sub->callback([&cmd, &exit_code] { exit_code = run_dense(cmd); });

@@ -482,6 +482,8 @@ TEST_F(BadInputTest, ZeroOrNegativeParameters) {
       {track, "--start", "-1", "--start"},
       {track, "--max-frames", "-1", "--max-frames"},
       {track, "--in-flight", "-1", "--in-flight"},
+      {track, "--decode-threads", "-1", "--decode-threads"},
+      {dense, "--decode-threads", "65", "--decode-threads"},
       {track, "--threads", "0", "--threads"},
       {track, "--init", "5,5,0,10", "--init"},
       {track, "--init", "5,5,10,-10", "--init"},
