@@ -112,6 +112,8 @@ struct VideoDecoder::Impl {
         failure = "cannot decode frame: " + av_error_text(received);
         return received;
       }
+      // A drained decoder only ever answers EOF; should one ask for more, nothing is left.
+      if (draining) return AVERROR_EOF;
       // The decoder wants more input.
       const int read = av_read_frame(format, packet);
       if (read < 0) {
