@@ -14,8 +14,9 @@
 //   BM_Dense/<video>/threads:<n>            run_dense (paper preset), no sinks
 //
 // <video> is synthetic640x480 (300 frames of the demo's TrackingScene, written once as MPEG-4
-// to the temp dir) and, with ROIFLOW_VIDEOS=DIR, every .avi/.mp4/.mkv in DIR. One iteration
-// processes the whole file. Counters: fps, frames per wall-clock second of the whole run
+// to the temp dir), with ROIFLOW_BENCH_HD=1 synthetic1920x1080_h264 (the same scene at 1920x1080
+// as H.264, written once, ~30 s), and with ROIFLOW_VIDEOS=DIR every .avi/.mp4/.mkv in DIR. One
+// iteration processes the whole file. Counters: fps, frames per wall-clock second of the whole run
 // (decode included); tracker_fps, frames per second of the tracker's own busy time (pyramid +
 // LK + decision: decode excluded), global_activations.
 //
@@ -64,6 +65,24 @@ std::string synthetic_video() {
     for (int i = 0; i < scene.frames(); ++i)
       sink.write(scene.render(i));
     sink.close();
+  }
+  return path.string();
+}
+
+// The same scene at 1920x1080 as H.264 (ROIFLOW_BENCH_HD=1), written once; empty when this
+// FFmpeg has no H.264 encoder.
+std::string synthetic_hd_video() {
+  const fs::path path = fs::temp_directory_path() / "roiflow_bench_synthetic1920x1080_h264.mp4";
+  if (!fs::exists(path)) {
+    const fs::path partial = path.string() + ".partial.mp4";
+    stages::VideoSource scene("synthetic:300:1920x1080");
+    cv::VideoWriter writer(partial.string(), cv::CAP_FFMPEG,
+                           cv::VideoWriter::fourcc('a', 'v', 'c', '1'), 25, scene.size());
+    if (!writer.isOpened()) return {};
+    while (auto f = scene.next())
+      writer.write(f->image);
+    writer.release();
+    fs::rename(partial, path);
   }
   return path.string();
 }
@@ -256,6 +275,10 @@ void register_video(const std::string& name, const std::string& path) {
 
 int main(int argc, char** argv) {
   register_video("synthetic640x480", synthetic_video());
+  if (std::getenv("ROIFLOW_BENCH_HD") != nullptr) {
+    const std::string hd = synthetic_hd_video();
+    if (!hd.empty()) register_video("synthetic1920x1080_h264", hd);
+  }
   if (const char* dir = std::getenv("ROIFLOW_VIDEOS")) {
     std::vector<fs::path> videos;
     for (const auto& entry : fs::directory_iterator(dir)) {
