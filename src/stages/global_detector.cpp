@@ -134,7 +134,7 @@ struct GlobalDetector::Impl {
   long long observed = 0;
   cv::Mat fg_raw;  // MOG2's output for the last observed frame, at work_size
   // fg_raw cleaned by morphology, made when first asked for: the tracker's refreshes of the
-  // model while it holds the target never look at it (a third of a refresh's time).
+  // model while it holds the target never look at it.
   mutable cv::Mat foreground;
   mutable bool foreground_stale = false;
   cv::Mat small;  // the shrunk frame, kept to reuse its buffer

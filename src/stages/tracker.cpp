@@ -214,28 +214,20 @@ struct Tracker::Impl {
   void follow(const TrackerInput& frame, TrackerOutput& out, double refresh_weight);
 
   // The background model is only needed to find a target that was not given. `weight`: the
-  // frames of video this observation stands for.
-  void observe(const TrackerInput& frame, double weight = 1.0) {
+  // frames of video this observation stands for. `beside`: as a job of the executor, beside the
+  // frames that follow (a refresh while the target is held is not needed before it is lost);
+  // at once without an executor.
+  void observe(const TrackerInput& frame, double weight = 1.0, bool beside = false) {
     finish_refresh();
     if (params.init || observed_index == frame.index) return;
-    detector.observe(frame.image.empty() ? frame.gray : frame.image, weight);
-    observed_index = frame.index;
-  }
-
-  // observe() beside the frames that follow (executor's start; at once without an executor):
-  // a refresh of the model while the target is held is not needed before the target is lost.
-  void start_refresh(const TrackerInput& frame, double weight) {
-    finish_refresh();
-    if (params.init || observed_index == frame.index) return;
-    observed_index = frame.index;
-    const cv::Mat image = frame.image.empty() ? frame.gray : frame.image;  // kept alive by the job
-    GlobalDetector* model = &detector;
-    const auto job = [model, image, weight] { model->observe(image, weight); };
-    if (executor != nullptr) {
-      refresh = executor->start(job);
+    const cv::Mat image = frame.image.empty() ? frame.gray : frame.image;  // a job keeps it alive
+    if (beside && executor != nullptr) {
+      GlobalDetector* model = &detector;
+      refresh = executor->start([model, image, weight] { model->observe(image, weight); });
     } else {
-      job();
+      detector.observe(image, weight);
     }
+    observed_index = frame.index;
   }
 };
 
@@ -278,7 +270,7 @@ void Tracker::Impl::acquire(const TrackerInput& frame, TrackerOutput& out) {
 
 void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double refresh_weight) {
   const cv::Rect2f before = local.box();  // where the object was on the grid of region_flow
-  if (refresh_weight > 0) start_refresh(frame, refresh_weight);
+  if (refresh_weight > 0) observe(frame, refresh_weight, true);
   const LocalResult r = local.track({frame.gray, frame.pyramid});
   out.has_target = true;
   out.region = r.region;

@@ -156,15 +156,14 @@ struct VideoDecoder::Impl {
             "video '" + path + "': no conversion from pixel format " +
             (av_get_pix_fmt_name(source_format) ? av_get_pix_fmt_name(source_format) : "?") +
             " to BGR");
-      const int* coefficients = sws_getCoefficients(SWS_CS_DEFAULT);
       int* inv = nullptr;
       int* table = nullptr;
       int src_range = 0, dst_range = 0, brightness = 0, contrast = 0, saturation = 0;
       if (sws_getColorspaceDetails(sws, &inv, &src_range, &table, &dst_range, &brightness,
                                    &contrast, &saturation) >= 0 &&
           src_range != static_cast<int>(full)) {
-        sws_setColorspaceDetails(sws, coefficients, full ? 1 : 0, coefficients, dst_range,
-                                 brightness, contrast, saturation);
+        sws_setColorspaceDetails(sws, inv, full ? 1 : 0, table, dst_range, brightness, contrast,
+                                 saturation);
       }
       sws_format = frame->format;
       sws_size = cv::Size(w, h);
@@ -186,8 +185,7 @@ struct VideoDecoder::Impl {
         // convertTo's SIMD path (0.04 ms at 640x480; cv::LUT took 0.6 ms, a scalar loop 0.3).
         luma.convertTo(out.gray, CV_8U, 255.0 / 219.0, -16.0 * 255.0 / 219.0);
     } else {
-      cv::Mat gray = out.gray;
-      cv::cvtColor(out.bgr, gray, cv::COLOR_BGR2GRAY);
+      cv::cvtColor(out.bgr, out.gray, cv::COLOR_BGR2GRAY);
     }
 
     const int64_t pts = frame->best_effort_timestamp;

@@ -10,9 +10,9 @@
 // Why not cv::VideoCapture: it converts every frame to BGR, then copies it into the caller's
 // Mat, and the caller converts that to gray again; with frame threads on (it always asks
 // FFmpeg for them) a 640x480 MPEG-4 stream decodes slower than on one thread and keeps both
-// cores of a two-core machine busy doing it (pipeline_bench BM_Decode: 1.6 cores, ~0.9 ms of
-// CPU a frame, against ~0.45 ms here). Here the gray frame is the decoder's own luma plane
-// (expanded from video range 16..235 to 0..255, so it equals the BT.601 gray of the BGR frame
+// cores of a two-core machine busy doing it (pipeline_bench BM_DecodeOpenCV: 1.6 cores, ~0.9 ms
+// of CPU a frame, against ~0.45 ms here on one core). Here the gray frame is the decoder's own luma
+// plane (expanded from video range 16..235 to 0..255, so it equals the BT.601 gray of the BGR frame
 // within rounding), the BGR frame is converted once into its final buffer, and both come from
 // a small pool of buffers that are reused once nobody else holds them (no page faults per
 // frame).
@@ -23,11 +23,12 @@
 // choice (one per core) for larger ones. A tracking pipeline wants its other cores for itself.
 //
 // Errors: the constructor throws roiflow::Error naming the file when it cannot be opened, has
-// no video stream or no decoder for it, or announces a frame size outside the frame limits.
-// read() returns false at the end of the stream (failure empty) or when a packet cannot be
-// decoded, a frame cannot be converted, or the frame size changes mid-stream (failure says
-// which): the caller stops there. The FFmpeg log level
-// follows OPENCV_FFMPEG_LOGLEVEL when it is set, as with OpenCV's own FFmpeg backend.
+// no video stream or no decoder for it, or `threads` < 0 (the frame-size limits are
+// VideoSource's, checked on size() before any frame is decoded). read() returns false at the
+// end of the stream (failure empty) or when a packet cannot be decoded, a frame cannot be
+// converted, or the frame size changes mid-stream (failure says which): the caller stops
+// there. The FFmpeg log level follows OPENCV_FFMPEG_LOGLEVEL when it is set, as with OpenCV's
+// own FFmpeg backend.
 #pragma once
 
 #include <memory>
