@@ -108,8 +108,10 @@ void ccoeff_normed_direct(const cv::Mat& image, const cv::Mat& templ, cv::Mat& r
   // whole-vector multiply-adds, reduced once per position.
   const int twp = (tw + kLanes - 1) / kLanes * kLanes;
   const int ipw = iw + twp + 4;
-  scratch.templ.assign(static_cast<std::size_t>(th) * twp, 0.f);
-  scratch.image.assign(static_cast<std::size_t>(ih) * ipw, 0.f);
+  // Only what is read is written: zeroing whole buffers on every call cost as much as the sums
+  // (the padding is zeroed row by row below; an integral image's first row and column here).
+  scratch.templ.resize(static_cast<std::size_t>(th) * twp);
+  scratch.image.resize(static_cast<std::size_t>(ih) * ipw);
   const cv::Mat tp(th, twp, CV_32F, scratch.templ.data());
   const cv::Mat ip(ih, ipw, CV_32F, scratch.image.data());
   const auto t_mean = static_cast<float>(cv::mean(templ)[0]);
@@ -123,11 +125,14 @@ void ccoeff_normed_direct(const cv::Mat& image, const cv::Mat& templ, cv::Mat& r
       dst[x] = src[x] - t_mean;
       acc += dst[x] * dst[x];
     }
+    std::fill(dst + tw, dst + twp, 0.f);
     t_norm2 += acc;
   }
   const std::size_t sw = static_cast<std::size_t>(iw) + 1;
-  scratch.sum.assign(sw * (ih + 1), 0.0);
-  scratch.sqsum.assign(sw * (ih + 1), 0.0);
+  scratch.sum.resize(sw * (ih + 1));
+  scratch.sqsum.resize(sw * (ih + 1));
+  std::fill_n(scratch.sum.begin(), sw, 0.0);
+  std::fill_n(scratch.sqsum.begin(), sw, 0.0);
   for (int y = 0; y < ih; ++y) {
     const float* src = image.ptr<float>(y);
     float* dst = scratch.image.data() + static_cast<std::size_t>(y) * ipw;
@@ -136,6 +141,8 @@ void ccoeff_normed_direct(const cv::Mat& image, const cv::Mat& templ, cv::Mat& r
     double* s_row = scratch.sum.data() + (y + 1) * sw;
     double* q_row = scratch.sqsum.data() + (y + 1) * sw;
     double s = 0, q = 0;
+    s_row[0] = 0.0;
+    q_row[0] = 0.0;
     for (int x = 0; x < iw; ++x) {
       dst[x] = src[x] - i_mean;
       s += dst[x];
@@ -143,6 +150,7 @@ void ccoeff_normed_direct(const cv::Mat& image, const cv::Mat& templ, cv::Mat& r
       s_row[x + 1] = s_up[x + 1] + s;
       q_row[x + 1] = q_up[x + 1] + q;
     }
+    std::fill(dst + iw, dst + ipw, 0.f);
   }
   response.create(ny, nx, CV_32F);
   for (int y = 0; y < ny; ++y) {
