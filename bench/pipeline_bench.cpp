@@ -28,6 +28,13 @@
 //                                           wall time: how busy the machine was); also
 //                                           opencv_decode_fps and vs_opencv_decode, the same
 //                                           against BM_DecodeOpenCV's way of decoding
+//   BM_TrackerOnly/<video>                  the tracker alone (default params, no executor) on
+//                                           the frames decoded once into memory, five
+//                                           repetitions (median and min): ms_per_frame over all
+//                                           frames, local_ms_per_frame over those the local
+//                                           treatment kept (its background refresh included,
+//                                           which a pipeline runs beside the frames): the serial
+//                                           step that bounds tracking's frames/s at 2 threads
 #include <benchmark/benchmark.h>
 
 #include <sys/resource.h>
@@ -35,6 +42,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 #include <string>
@@ -223,6 +231,37 @@ void bm_track_vs_decode(benchmark::State& state, const std::string& path, int th
   state.counters["vs_opencv_decode"] = median_of(opencv_ratio);
 }
 
+// The tracker alone on frames decoded once into memory, one thread, no graph: the serial step
+// that bounds tracking's frames/s at 2 threads (the other thread decodes). Counters: ms_per_frame
+// over every frame (global activations included) and local_ms_per_frame over the frames the
+// local treatment kept.
+void bm_tracker_only(benchmark::State& state, const std::string& path) {
+  // Decoded once for all repetitions.
+  static std::map<std::string, std::vector<stages::Frame>> decoded;
+  std::vector<stages::Frame>& frames = decoded[path];
+  if (frames.empty()) {
+    stages::VideoSource source(path);
+    while (auto f = source.next())
+      frames.push_back(std::move(*f));
+  }
+  double total_ms = 0, local_ms = 0;
+  long long runs = 0, local_frames = 0;
+  for (auto _ : state) {
+    stages::Tracker tracker(stages::TrackerParams{});
+    for (const stages::Frame& f : frames) {
+      const stages::TrackerOutput out = tracker.process({f.index, f.image, f.gray, nullptr});
+      total_ms += out.ms;
+      if (out.mode == stages::TrackRecord::Mode::Local && !out.lost) {
+        local_ms += out.ms;
+        ++local_frames;
+      }
+    }
+    ++runs;
+  }
+  state.counters["ms_per_frame"] = total_ms / static_cast<double>(runs * frames.size());
+  state.counters["local_ms_per_frame"] = local_frames > 0 ? local_ms / local_frames : 0.0;
+}
+
 void bm_dense(benchmark::State& state, const std::string& path, int threads) {
   long long pairs = 0;
   for (auto _ : state) {
@@ -257,6 +296,12 @@ void register_video(const std::string& name, const std::string& path) {
           ->Iterations(1);
     }
   }
+  benchmark::RegisterBenchmark(("BM_TrackerOnly/" + name).c_str(), bm_tracker_only, path)
+      ->Unit(benchmark::kMillisecond)
+      ->Repetitions(5)
+      ->ComputeStatistics(
+          "min", [](const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); })
+      ->ReportAggregatesOnly(true);
   benchmark::RegisterBenchmark(("BM_TrackVsDecode/" + name + "/local/threads:2").c_str(),
                                bm_track_vs_decode, path, 2)
       ->Unit(benchmark::kMillisecond)
