@@ -230,7 +230,7 @@ struct LocalTracker::Impl {
   int since_recent = 0;
 
   // Buffers reused from frame to frame.
-  flow::Pyramid view_prev, view_cur;
+  flow::Pyramid view_prev, view_cur, view_next;
   flow::FlowResult forward;
   flow::FlowResult backward;
   std::vector<cv::Point2f> from, to;
@@ -322,25 +322,48 @@ struct LocalTracker::Impl {
     flow::build_pyramid(gray(rect), levels, params.lk.sigma, out.pyr);
   }
 
-  // The part of the frame a step reads: LK's footprint over the region, the appearance search
-  // around a box that may have moved anywhere in the region, and a border for the smoothing
-  // and pyrDown at the part's edges (where the part's values differ from the whole frame's).
+  // Pixels at a part's edges where its values differ from the whole frame's (the smoothing and
+  // pyrDown there see a replicated border instead of the frame).
+  int border() const { return 3 << (levels - 1); }
+
+  // `r` grown by the border and aligned: the part whose values equal the whole frame's over `r`.
+  cv::Rect part_for(const cv::Rect& r) const {
+    const int m = border();
+    return aligned(cv::Rect(r.x - m, r.y - m, r.width + 2 * m, r.height + 2 * m));
+  }
+
+  // The part of the frame LK reads in a step: its footprint over the region and a margin for the
+  // velocity. The appearance search reads around the measured box, which lies in the region, so
+  // a step covers it (and rarely has to grow the part: match_need) only once the flow has placed
+  // the box; a margin for a box that may have moved anywhere in the region made parts ~1.4x
+  // larger.
   cv::Rect step_part(const cv::Rect& region, int lk_level) const {
     if (params.whole_frame) return frame_rect();
     flow::FlowOptions o;
     o.region = region;
     o.context = params.lk_context;
     o.finest_level = lk_level;
-    cv::Rect need = flow::flow_footprint(size, params.lk, o);
-    const double side = std::max(box.width, box.height) * kMaxScaleChange;
-    const int search = static_cast<int>(
-        std::ceil(0.5 * side + 2.0 * params.search * std::min(box.width, box.height)));
-    const int border = 3 << (levels - 1);
+    const cv::Rect need = flow::flow_footprint(size, params.lk, o);
     const int motion = static_cast<int>(std::ceil(std::hypot(velocity.x, velocity.y)));
-    need |= cv::Rect(region.x - search, region.y - search, region.width + 2 * search,
-                     region.height + 2 * search);
-    const int m = border + motion;
-    return aligned(cv::Rect(need.x - m, need.y - m, need.width + 2 * m, need.height + 2 * m));
+    return part_for(cv::Rect(need.x - motion, need.y - motion, need.width + 2 * motion,
+                             need.height + 2 * motion));
+  }
+
+  // What match() of `appearance` around `b` reads, level-0 pixels: every scale's search window on
+  // the match level (the other scales' windows lie a few pixels around the measured scale's best
+  // position), with a pixel of that level for each rounding.
+  cv::Rect match_need(const cv::Mat& appearance, const cv::Rect2f& b, double reach) const {
+    const double shorter = std::min(b.width, b.height);
+    const int level = coarsest_level_with(shorter, params.match_side, levels);
+    const double k = 1 << level;
+    const double radius = reach * std::max(3.0, params.search * shorter / k);  // level pixels
+    const double grow = std::pow(1.0 + params.scale_step, params.scale_steps) *
+                        std::sqrt(static_cast<double>(b.area()) / appearance.size().area());
+    const double half_w = 0.5 * appearance.cols * grow + (radius + 5.0) * k;
+    const double half_h = 0.5 * appearance.rows * grow + (radius + 5.0) * k;
+    const cv::Point2f c = centre(b);
+    return enclosing(cv::Rect2f(c.x - static_cast<float>(half_w), c.y - static_cast<float>(half_h),
+                                static_cast<float>(2 * half_w), static_cast<float>(2 * half_h)));
   }
 
   // The coarsest level where the object's shorter side still spans lk_patches LK patches (0 in
@@ -354,6 +377,16 @@ struct LocalTracker::Impl {
     flow::FlowOptions o;
     o.finest_level = lk_level;
     return flow::flow_pyramid_levels(size, params.lk, o);
+  }
+
+  // Grows frame t's part (rebuilt, rarely) until its values equal the whole frame's over `need`.
+  void cover(const LocalFrame& in, const cv::Rect& need) {
+    const cv::Rect want = part_for(need & frame_rect());
+    if ((next_part.rect & want) == want) return;
+    view_cur.levels.clear();
+    view_next.levels.clear();
+    build(in.gray, in.pyramid, aligned(next_part.rect | want), next_part);
+    view(next_part, next_part.rect, levels, view_next);
   }
 
   Appearance match(const cv::Mat& appearance, ScaledTemplates& sizes, const flow::Pyramid& pyr,
@@ -504,6 +537,7 @@ LocalResult LocalTracker::Impl::track(const LocalFrame& in) {
   const cv::Rect part = step_part(r.region, r.level);
   view_prev.levels.clear();  // the last step's views: let go so that builds reuse buffers
   view_cur.levels.clear();
+  view_next.levels.clear();
   // The part of frame t-1 built by the last step serves when it covers this one with as many
   // levels (a part is on the grid of its coarsest level, so also on that of every finer one).
   if ((prev_part.rect & part) != part || prev_part.pyr.num_levels() < levels) {
@@ -520,6 +554,7 @@ LocalResult LocalTracker::Impl::track(const LocalFrame& in) {
   built = true;
   view(prev_part, part, levels, view_prev);
   view(next_part, part, levels, view_cur);
+  view(next_part, next_part.rect, levels, view_next);
   const cv::Point origin = part.tl();
 
   flow::FlowOptions opt;
@@ -606,9 +641,15 @@ LocalResult LocalTracker::Impl::track(const LocalFrame& in) {
   // the object) the appearance alone may still find it near the prediction, over a wider search.
   const cv::Rect2f flow_box = box_at(c, box.size() * static_cast<float>(scale));
   const double reach = flow_failure == LostReason::Found ? 1.0 : 2.0;
-  Appearance a = match(templ, templ_sizes, view_cur, origin, flow_box, reach);
+  // The appearance search and the recent appearance's cut read frame t's part beyond LK's (the
+  // whole part built so far, grown where they need more).
+  cv::Rect need = match_need(templ, flow_box, reach);
+  if (!recent.empty()) need |= match_need(recent, flow_box, reach);
+  cover(in, need);
+  const cv::Point next_origin = next_part.rect.tl();
+  Appearance a = match(templ, templ_sizes, view_next, next_origin, flow_box, reach);
   if (a.score < params.trust_appearance && !recent.empty()) {
-    const Appearance b = match(recent, recent_sizes, view_cur, origin, flow_box, reach);
+    const Appearance b = match(recent, recent_sizes, view_next, next_origin, flow_box, reach);
     if (b.score > a.score) a = b;
   }
   r.appearance = a.score;
@@ -638,7 +679,9 @@ LocalResult LocalTracker::Impl::track(const LocalFrame& in) {
   ++since_recent;
   if (flow_failure == LostReason::Found && a.score >= params.trust_appearance && r.inliers >= 0.5 &&
       since_recent >= params.template_interval) {
-    cut(view_cur, origin, box, recent);
+    const cv::Rect b = enclosing(box);
+    cover(in, cv::Rect(b.x - 2, b.y - 2, b.width + 4, b.height + 4));
+    cut(view_next, next_part.rect.tl(), box, recent);
     recent_sizes.clear();
     since_recent = 0;
   }
