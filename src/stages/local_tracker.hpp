@@ -64,7 +64,7 @@ struct LocalTrackerParams {
   int roi = 50;  // least side of the local region in pixels (the paper's 50x50), 8..4096
   flow::LkParams lk = flow::LkParams::paper();
   bool whole_frame = false;       // LK over the whole frame (the paper's global-mode baseline)
-  int lk_context = 8;             // pixels of LK context around the region at each level
+  int lk_context = 4;             // pixels of LK context around the region at each level
                                   // (flow::FlowOptions::context): the region already holds the
                                   // object with a margin, and the exact context (-1) would cost
                                   // several times the region itself; -1..1000
