@@ -180,6 +180,45 @@ TEST(Tracker, WithoutInitTheMovingObjectIsDetectedThenTrackedLocally) {
   EXPECT_EQ(outs.back().global_activations, static_cast<long long>(found) + 2);
 }
 
+// The demo's scene seen by a camera that starts panning on frame `pan_from` (the picture moves
+// by `speed` pixels a frame to the left, borders replicated), and the truth moved alike.
+struct PanningScene {
+  const flow::TrackingScene& scene;
+  int pan_from;
+  float speed;
+  float shift(int i) const {
+    return i > pan_from ? -speed * static_cast<float>(i - pan_from) : 0.f;
+  }
+  cv::Mat render(int i) const {
+    const cv::Mat m = (cv::Mat_<double>(2, 3) << 1, 0, shift(i), 0, 1, 0);
+    cv::Mat out;
+    cv::warpAffine(scene.render(i), out, m, scene.size(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+    return out;
+  }
+  cv::Rect2f box(int i) const { return scene.box(i) + cv::Point2f(shift(i), 0.f); }
+};
+
+TEST(Tracker, AfterAJumpWhileTheCameraPansTheTargetIsFoundByAppearance) {
+  flow::TrackingSceneParams p = small_scene(60.0);
+  p.frames = 50;
+  p.jump_frame = 40;
+  const flow::TrackingScene scene(p);
+  const PanningScene panning{scene, 25, 2.f};
+  Tracker tracker(TrackerParams{});
+  int found_again = -1;
+  for (int i = 0; i < p.frames; ++i) {
+    const TrackerOutput out = tracker.process(input(tracker, panning.render(i), i));
+    if (i >= p.jump_frame && found_again < 0 && out.has_target && !out.lost &&
+        iou(out.box, panning.box(i)) > 0.5) {
+      found_again = i;
+    }
+  }
+  // The background model sees the whole panned picture move: the lost target is searched by
+  // its appearance, not among the moving blobs.
+  ASSERT_GE(found_again, p.jump_frame);
+  EXPECT_LE(found_again, p.jump_frame + 2);
+}
+
 TEST(Tracker, RecordIsOneBased) {
   TrackerOutput o;
   o.index = 4;
