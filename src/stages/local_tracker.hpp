@@ -93,7 +93,7 @@ struct LocalTrackerParams {
                                    // side (at least 3 pixels of the match level), (0, 2]
   double scale_step = 0.03;        // relative step between the matched scales, (0, 0.5)
   int scale_steps = 1;             // scales matched on each side of the measured one, 0..10
-  int match_side = 24;             // the shorter side the template is matched at (the finest
+  int match_side = 20;             // the shorter side the template is matched at (the finest
                                    // pyramid level where the object is at least this size), 8..256
   int template_interval = 10;      // frames between refreshes of the recent appearance (taken
                                    // only from confidently tracked frames), >= 1
