@@ -28,6 +28,9 @@
 //                                           wall time: how busy the machine was); also
 //                                           opencv_decode_fps and vs_opencv_decode, the same
 //                                           against BM_DecodeOpenCV's way of decoding
+//   BM_GraphOnly/<video>/threads:2          run_tracking with a step that does nothing (five
+//                                           repetitions): what the graph itself costs over
+//                                           BM_Decode, the ceiling of any tracking run
 //   BM_TrackerOnly/<video>                  the tracker alone (default params, no executor) on
 //                                           the frames decoded once into memory, five
 //                                           repetitions (median and min): ms_per_frame over all
@@ -231,6 +234,27 @@ void bm_track_vs_decode(benchmark::State& state, const std::string& path, int th
   state.counters["vs_opencv_decode"] = median_of(opencv_ratio);
 }
 
+// The graph with a tracking step that does nothing: decode, limiter, sequencer and retirement at
+// 2 threads, the ceiling of any tracking run through the graph.
+void bm_graph_only(benchmark::State& state, const std::string& path) {
+  long long frames = 0;
+  for (auto _ : state) {
+    stages::VideoSource source(path);
+    pipeline::TrackStep step;
+    step.wants_pyramid = [] { return false; };
+    step.process = [](const stages::TrackerInput& in) {
+      stages::TrackerOutput out;
+      out.index = in.index;
+      return out;
+    };
+    pipeline::GraphOptions options;
+    options.threads = 2;
+    frames += pipeline::run_tracking([&] { return source.next(); }, step, {}, options).frames;
+  }
+  state.counters["fps"] =
+      benchmark::Counter(static_cast<double>(frames), benchmark::Counter::kIsRate);
+}
+
 // The tracker alone on frames decoded once into memory, one thread, no graph: the serial step
 // that bounds tracking's frames/s at 2 threads (the other thread decodes). Counters: ms_per_frame
 // over every frame (global activations included) and local_ms_per_frame over the frames the
@@ -296,6 +320,12 @@ void register_video(const std::string& name, const std::string& path) {
           ->Iterations(1);
     }
   }
+  benchmark::RegisterBenchmark(("BM_GraphOnly/" + name + "/threads:2").c_str(), bm_graph_only, path)
+      ->Unit(benchmark::kMillisecond)
+      ->UseRealTime()
+      ->Iterations(1)
+      ->Repetitions(5)
+      ->ReportAggregatesOnly(true);
   benchmark::RegisterBenchmark(("BM_TrackerOnly/" + name).c_str(), bm_tracker_only, path)
       ->Unit(benchmark::kMillisecond)
       ->Repetitions(5)
