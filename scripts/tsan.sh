@@ -6,7 +6,9 @@
 #
 # Debian's oneTBB is not instrumented, so scripts/tsan_tbb.sh first builds Debian's own oneTBB
 # source with -fsanitize=thread (once, ~1 minute); the tsan preset links it. What TSan cannot see
-# into (OpenCV, FFmpeg) is listed in tests/tsan.supp with the reason.
+# into (OpenCV, FFmpeg) is listed in tests/tsan.supp with the reason. The preset leaves out
+# tests that start no thread of their own and would cost minutes under TSan (e.g.
+# Tracker.TheWholeFramePyramidsNeverChangeTheResult: nine serial tracker runs, 3 minutes).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/deps.sh
