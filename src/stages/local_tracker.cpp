@@ -37,6 +37,11 @@ cv::Rect enclosing(const cv::Rect2f& r) {
   return {x0, y0, x1 - x0, y1 - y0};
 }
 
+// `r` grown by `m` pixels on every side.
+cv::Rect grown(const cv::Rect& r, int m) {
+  return {r.x - m, r.y - m, r.width + 2 * m, r.height + 2 * m};
+}
+
 // Median by partial sort; reorders `v`, which must not be empty.
 float median(std::vector<float>& v) {
   const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
@@ -327,10 +332,7 @@ struct LocalTracker::Impl {
   int border() const { return 3 << (levels - 1); }
 
   // `r` grown by the border and aligned: the part whose values equal the whole frame's over `r`.
-  cv::Rect part_for(const cv::Rect& r) const {
-    const int m = border();
-    return aligned(cv::Rect(r.x - m, r.y - m, r.width + 2 * m, r.height + 2 * m));
-  }
+  cv::Rect part_for(const cv::Rect& r) const { return aligned(grown(r, border())); }
 
   // The part of the frame LK reads in a step: its footprint over the region and a margin for the
   // velocity. The appearance search reads around the measured box, which lies in the region, so
@@ -345,8 +347,7 @@ struct LocalTracker::Impl {
     o.finest_level = lk_level;
     const cv::Rect need = flow::flow_footprint(size, params.lk, o);
     const int motion = static_cast<int>(std::ceil(std::hypot(velocity.x, velocity.y)));
-    return part_for(cv::Rect(need.x - motion, need.y - motion, need.width + 2 * motion,
-                             need.height + 2 * motion));
+    return part_for(grown(need, motion));
   }
 
   // What match() of `appearance` around `b` reads, level-0 pixels: every scale's search window on
@@ -548,7 +549,7 @@ LocalResult LocalTracker::Impl::track(const LocalFrame& in) {
     const cv::Point shift(static_cast<int>(std::lround(velocity.x)),
                           static_cast<int>(std::lround(velocity.y)));
     ahead |= part + shift;
-    ahead = aligned(cv::Rect(ahead.x - 4, ahead.y - 4, ahead.width + 8, ahead.height + 8));
+    ahead = aligned(grown(ahead, 4));
   }
   build(in.gray, in.pyramid, ahead, next_part);
   built = true;
@@ -599,8 +600,7 @@ LocalResult LocalTracker::Impl::track(const LocalFrame& in) {
     cv::Rect2f moved(static_cast<float>(object.x) + rough.x, static_cast<float>(object.y) + rough.y,
                      static_cast<float>(object.width), static_cast<float>(object.height));
     const cv::Rect b = enclosing(moved);
-    opt.region =
-        (cv::Rect(b.x - pad, b.y - pad, b.width + 2 * pad, b.height + 2 * pad) & part) - origin;
+    opt.region = (grown(b, pad) & part) - origin;
   }
   opt.initial_motion = -rough;
   inliers.clear();
@@ -679,8 +679,7 @@ LocalResult LocalTracker::Impl::track(const LocalFrame& in) {
   ++since_recent;
   if (flow_failure == LostReason::Found && a.score >= params.trust_appearance && r.inliers >= 0.5 &&
       since_recent >= params.template_interval) {
-    const cv::Rect b = enclosing(box);
-    cover(in, cv::Rect(b.x - 2, b.y - 2, b.width + 4, b.height + 4));
+    cover(in, grown(enclosing(box), 2));
     cut(view_next, next_part.rect.tl(), box, recent);
     recent_sizes.clear();
     since_recent = 0;
@@ -754,7 +753,7 @@ void LocalTracker::start(const LocalFrame& frame, const cv::Rect2f& box) {
   // The appearance from the pyramid of the box and a margin wider than the smoothing: the
   // values there are the whole frame's.
   const cv::Rect b = enclosing(box);
-  const cv::Rect around = s.aligned(cv::Rect(b.x - 8, b.y - 8, b.width + 16, b.height + 16));
+  const cv::Rect around = s.aligned(grown(b, 8));
   s.build(frame.gray, frame.pyramid, around, s.prev_part);
   cut(s.prev_part.pyr, around.tl(), box, s.templ);
   s.templ_sizes.clear();
