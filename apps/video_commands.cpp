@@ -180,6 +180,9 @@ struct SourceOptions {
     p.start = start;
     p.max_frames = max_frames;
     p.decode_threads = decode_threads;
+    // Colour is converted only for the frames that need it: the video sink's and the few the
+    // tracker learns appearance or background from (Frame::picture()).
+    p.defer_colour = true;
     return p;
   }
 };
@@ -229,7 +232,7 @@ TrackRun track(const pipeline::FrameSource& source, cv::Size size, double fps, l
                    }});
   if (video) {
     sinks.push_back({"video", [&](const pipeline::TrackedFrame& f) {
-                       video->write(stages::annotate_frame(f.frame->image, *f.output));
+                       video->write(stages::annotate_frame(f.frame->picture(), *f.output));
                      }});
   }
   sinks.push_back(

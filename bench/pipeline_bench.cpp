@@ -6,6 +6,9 @@
 //
 //   BM_Decode/<video>                       VideoSource alone (FFmpeg through VideoDecoder, BGR
 //                                           and gray): the ceiling of any pipeline
+//   BM_DecodeGray/<video>                   the same with colour deferred and never asked for
+//                                           (gray only): the ceiling of a pipeline that needs no
+//                                           colour, as tracking without a video sink mostly does
 //   BM_DecodeOpenCV/<video>                 cv::VideoCapture::read + cvtColor to gray, what a
 //                                           plain OpenCV program pays (VideoSource before it
 //                                           had its own decoder)
@@ -27,10 +30,14 @@
 //                                           decode_cores / track_cores (process CPU time over
 //                                           wall time: how busy the machine was); also
 //                                           opencv_decode_fps and vs_opencv_decode, the same
-//                                           against BM_DecodeOpenCV's way of decoding
+//                                           against BM_DecodeOpenCV's way of decoding, and
+//                                           gray_decode_fps / vs_gray_decode against
+//                                           BM_DecodeGray's. Tracking reads its input as the
+//                                           CLI does (VideoSourceParams::defer_colour)
 //   BM_GraphOnly/<video>/threads:2          run_tracking with a step that does nothing (five
-//                                           repetitions): what the graph itself costs over
-//                                           BM_Decode, the ceiling of any tracking run
+//                                           repetitions), input read as the CLI does: what the
+//                                           graph itself costs over BM_DecodeGray, the ceiling
+//                                           of any tracking run
 //   BM_TrackerOnly/<video>                  the tracker alone (default params, no executor) on
 //                                           the frames decoded once into memory, five
 //                                           repetitions (median and min): ms_per_frame over all
@@ -103,9 +110,28 @@ double ms_total(const nlohmann::ordered_json& stats, const char* stage) {
   return stages.contains(stage) ? stages.at(stage).at("ms_total").get<double>() : 0.0;
 }
 
+// How the CLI reads a video for tracking and dense mode: colour only when asked for.
+stages::VideoSourceParams as_the_cli() {
+  stages::VideoSourceParams params;
+  params.defer_colour = true;
+  return params;
+}
+
 // One decode-only pass over the file: its frame count.
 long long decode_all(const std::string& path) {
   stages::VideoSource source(path);
+  long long frames = 0;
+  while (auto f = source.next()) {
+    benchmark::DoNotOptimize(f->image.data);
+    benchmark::DoNotOptimize(f->gray.data);
+    ++frames;
+  }
+  return frames;
+}
+
+// One decode-only pass with colour deferred and never asked for: its frame count.
+long long decode_all_gray(const std::string& path) {
+  stages::VideoSource source(path, as_the_cli());
   long long frames = 0;
   while (auto f = source.next()) {
     benchmark::DoNotOptimize(f->gray.data);
@@ -130,7 +156,7 @@ long long decode_all_opencv(const std::string& path) {
 // One tracking run of the file (default params but `mode`), no sinks; `stats` may be null.
 pipeline::RunReport track_all(const std::string& path, stages::TrackMode mode, int threads,
                               stages::RunStats* stats, long long* activations = nullptr) {
-  stages::VideoSource source(path);
+  stages::VideoSource source(path, as_the_cli());
   pipeline::TbbExecutor tiles;
   stages::TrackerParams params;
   params.mode = mode;
@@ -205,7 +231,7 @@ double median_of(std::vector<double> v) {
 void bm_track_vs_decode(benchmark::State& state, const std::string& path, int threads) {
   constexpr int kRounds = 5;
   std::vector<double> decode, track, ratio, decode_cores, track_cores, opencv, opencv_ratio,
-      opencv_cores;
+      opencv_cores, gray, gray_ratio, gray_cores;
   // Cores kept busy: process CPU time over wall time of a pass.
   auto timed = [](auto&& pass, std::vector<double>& cores) {
     const double cpu0 = process_cpu_s();
@@ -221,8 +247,10 @@ void bm_track_vs_decode(benchmark::State& state, const std::string& path, int th
       decode.push_back(timed([&] { return decode_fps<decode_all>(path); }, decode_cores));
       track.push_back(timed([&] { return tracking_fps(path, threads); }, track_cores));
       opencv.push_back(timed([&] { return decode_fps<decode_all_opencv>(path); }, opencv_cores));
+      gray.push_back(timed([&] { return decode_fps<decode_all_gray>(path); }, gray_cores));
       ratio.push_back(track.back() / decode.back());
       opencv_ratio.push_back(track.back() / opencv.back());
+      gray_ratio.push_back(track.back() / gray.back());
     }
   }
   state.counters["decode_fps"] = median_of(decode);
@@ -232,6 +260,8 @@ void bm_track_vs_decode(benchmark::State& state, const std::string& path, int th
   state.counters["track_cores"] = median_of(track_cores);
   state.counters["opencv_decode_fps"] = median_of(opencv);
   state.counters["vs_opencv_decode"] = median_of(opencv_ratio);
+  state.counters["gray_decode_fps"] = median_of(gray);
+  state.counters["vs_gray_decode"] = median_of(gray_ratio);
 }
 
 // The graph with a tracking step that does nothing: decode, limiter, sequencer and retirement at
@@ -239,7 +269,7 @@ void bm_track_vs_decode(benchmark::State& state, const std::string& path, int th
 void bm_graph_only(benchmark::State& state, const std::string& path) {
   long long frames = 0;
   for (auto _ : state) {
-    stages::VideoSource source(path);
+    stages::VideoSource source(path, as_the_cli());
     pipeline::TrackStep step;
     step.wants_pyramid = [] { return false; };
     step.process = [](const stages::TrackerInput& in) {
@@ -264,7 +294,7 @@ void bm_tracker_only(benchmark::State& state, const std::string& path) {
   static std::map<std::string, std::vector<stages::Frame>> decoded;
   std::vector<stages::Frame>& frames = decoded[path];
   if (frames.empty()) {
-    stages::VideoSource source(path);
+    stages::VideoSource source(path, as_the_cli());
     while (auto f = source.next())
       frames.push_back(std::move(*f));
   }
@@ -273,7 +303,8 @@ void bm_tracker_only(benchmark::State& state, const std::string& path) {
   for (auto _ : state) {
     stages::Tracker tracker(stages::TrackerParams{});
     for (const stages::Frame& f : frames) {
-      const stages::TrackerOutput out = tracker.process({f.index, f.image, f.gray, nullptr});
+      const stages::TrackerOutput out =
+          tracker.process({f.index, f.image, f.gray, nullptr, f.deferred_image});
       total_ms += out.ms;
       if (out.mode == stages::TrackRecord::Mode::Local && !out.lost) {
         local_ms += out.ms;
@@ -289,7 +320,7 @@ void bm_tracker_only(benchmark::State& state, const std::string& path) {
 void bm_dense(benchmark::State& state, const std::string& path, int threads) {
   long long pairs = 0;
   for (auto _ : state) {
-    stages::VideoSource source(path);
+    stages::VideoSource source(path, as_the_cli());
     pipeline::GraphOptions options;
     options.threads = threads;
     const pipeline::RunReport report =
@@ -302,6 +333,10 @@ void bm_dense(benchmark::State& state, const std::string& path, int threads) {
 
 void register_video(const std::string& name, const std::string& path) {
   benchmark::RegisterBenchmark(("BM_Decode/" + name).c_str(), bm_decode<decode_all>, path)
+      ->Unit(benchmark::kMillisecond)
+      ->UseRealTime()
+      ->Iterations(1);
+  benchmark::RegisterBenchmark(("BM_DecodeGray/" + name).c_str(), bm_decode<decode_all_gray>, path)
       ->Unit(benchmark::kMillisecond)
       ->UseRealTime()
       ->Iterations(1);

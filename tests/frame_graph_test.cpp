@@ -213,7 +213,7 @@ TEST_P(FrameGraphThreads, TheTrackerGivesTheSerialResult) {
     stages::Tracker tracker(params);
     for (int i = 0; i < scene.frames(); ++i) {
       const stages::Frame f = frame(i);
-      serial.push_back(tracker.process({f.index, f.image, f.gray, nullptr}));
+      serial.push_back(tracker.process({f.index, f.image, f.gray, nullptr, f.deferred_image}));
     }
   }
   ASSERT_GE(serial.back().global_activations, 2);  // detection, and the jump

@@ -305,6 +305,40 @@ TEST(Tracker, TheWholeFramePyramidsNeverChangeTheResult) {
   }
 }
 
+// A frame whose colour comes deferred (as a video read with VideoSourceParams::defer_colour)
+// gives the same result; the tracker asks for colour only on frames of the global treatment and
+// of its background refresh.
+TEST(Tracker, DeferredColourIsMadeOnlyWhenNeededAndChangesNothing) {
+  const flow::TrackingScene scene(small_scene(60.0));
+  TrackerParams params;
+  params.detector.warmup = 2;
+  const std::vector<TrackerOutput> eager = run(scene, params);
+  Tracker tracker(params);
+  int made = 0;
+  long long global_frames = 0;
+  for (int i = 0; i < scene.frames(); ++i) {
+    TrackerInput in = input(tracker, scene.render(i), i);
+    const cv::Mat bgr = in.image;
+    in.image = cv::Mat();
+    in.deferred_image = std::make_shared<const DeferredImage>([bgr, &made] {
+      ++made;
+      return bgr;
+    });
+    const TrackerOutput out = tracker.process(in);
+    tracker.finish_background_work();
+    const TrackerOutput& e = eager[static_cast<std::size_t>(i)];
+    EXPECT_EQ(out.box, e.box) << "frame " << i;
+    EXPECT_EQ(out.mode, e.mode) << "frame " << i;
+    EXPECT_EQ(out.lost, e.lost) << "frame " << i;
+    if (out.mode == TrackRecord::Mode::Global) ++global_frames;
+  }
+  // The refreshes: every observe_interval-th frame while the target is held.
+  const long long refreshes = scene.frames() / params.observe_interval + 1;
+  EXPECT_GT(made, 0);
+  EXPECT_LE(made, global_frames + refreshes);
+  EXPECT_LT(made, scene.frames() / 4);
+}
+
 TEST(Tracker, WantsWholePyramidsOnlyInGlobalModeOrUntilTheTargetIsKnown) {
   const flow::TrackingScene scene(small_scene(0.0));
   Tracker local(with_init(scene));

@@ -2,9 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
+#include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "test_util.hpp"
@@ -118,6 +121,65 @@ TEST_P(VideoDecoderTest, BuffersAreRecycledButNeverWhileHeld) {
   // Each frame was let go before the next was read: one buffer served them all.
   for (const uchar* data : seen)
     EXPECT_EQ(data, seen.front());
+}
+
+// With defer_bgr, the BGR picture is made on request, from any thread, after the decoder is
+// gone, and equals the one made at once, bit for bit; pictures held at once never share a buffer.
+TEST_P(VideoDecoderTest, DeferredBgrEqualsTheEagerOneFromAnyThreadAfterTheDecoderIsGone) {
+  const std::string file = write_video();
+  std::vector<cv::Mat> eager_bgr, eager_gray;
+  {
+    VideoDecoder video(file);
+    DecodedFrame f;
+    std::string failure;
+    while (video.read(f, failure)) {
+      EXPECT_FALSE(f.deferred_bgr);
+      eager_bgr.push_back(f.bgr.clone());
+      eager_gray.push_back(f.gray.clone());
+    }
+  }
+  ASSERT_EQ(static_cast<int>(eager_bgr.size()), kFrames);
+
+  std::vector<DecodedFrame> frames;
+  {
+    VideoDecoder video(file, 0, true);
+    DecodedFrame f;
+    std::string failure;
+    while (video.read(f, failure)) {
+      EXPECT_TRUE(f.bgr.empty());
+      ASSERT_TRUE(f.deferred_bgr);
+      frames.push_back(f);
+      f = DecodedFrame();  // the next read gets fresh buffers
+    }
+    EXPECT_EQ(failure, "");
+  }
+  ASSERT_EQ(frames.size(), eager_bgr.size());
+
+  // Four threads ask for every picture at once, in different orders.
+  constexpr int kThreads = 4;
+  std::vector<std::vector<cv::Mat>> got(kThreads, std::vector<cv::Mat>(frames.size()));
+  std::vector<std::thread> threads;
+  for (int t = 0; t < kThreads; ++t) {
+    threads.emplace_back([&, t] {
+      for (std::size_t k = 0; k < frames.size(); ++k) {
+        const std::size_t i = t % 2 == 0 ? k : frames.size() - 1 - k;
+        got[static_cast<std::size_t>(t)][i] = frames[i].deferred_bgr->get();
+      }
+    });
+  }
+  for (std::thread& thread : threads)
+    thread.join();
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    const cv::Mat& bgr = got[0][i];
+    ASSERT_EQ(bgr.type(), CV_8UC3);
+    ASSERT_EQ(bgr.size(), kSize);
+    EXPECT_EQ(cv::norm(bgr, eager_bgr[i], cv::NORM_INF), 0) << "frame " << i;
+    EXPECT_EQ(cv::norm(frames[i].gray, eager_gray[i], cv::NORM_INF), 0) << "frame " << i;
+    for (int t = 1; t < kThreads; ++t)
+      EXPECT_EQ(got[static_cast<std::size_t>(t)][i].data, bgr.data) << "made twice: frame " << i;
+    for (std::size_t j = 0; j < i; ++j)
+      EXPECT_NE(got[0][j].data, bgr.data) << "frames " << j << " and " << i << " share a buffer";
+  }
 }
 
 std::string codec_name(const ::testing::TestParamInfo<Codec>& codec) {

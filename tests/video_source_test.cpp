@@ -2,13 +2,16 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
+#include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "test_util.hpp"
@@ -71,7 +74,7 @@ void expect_in_order(const std::vector<Frame>& frames, long long first, int n) {
     EXPECT_EQ(frame.index, first + i);
     EXPECT_EQ(frame.gray.type(), CV_8UC1);
     EXPECT_EQ(frame.gray.size(), kSize);
-    EXPECT_EQ(frame.image.size(), kSize);
+    EXPECT_EQ(frame.picture().size(), kSize);
     EXPECT_NEAR(square_x(frame.gray), 4 + 4 * frame.index + 5.5, 1.0) << "frame " << i;
     if (i > 0) {
       EXPECT_GT(frame.timestamp_s, frames[static_cast<std::size_t>(i) - 1].timestamp_s);
@@ -130,6 +133,65 @@ TEST_F(VideoSourceTest, ReadsVideoFileInOrderWithIncreasingTimestamps) {
   EXPECT_EQ(source.status().state, State::kEnded);
   EXPECT_EQ(source.status().message, "end of stream");
   EXPECT_FALSE(source.next());
+}
+
+// defer_colour: a video's frames carry their picture deferred, equal to the one read at once;
+// other inputs (an image folder here) ignore it.
+TEST_F(VideoSourceTest, DeferredColourGivesTheSamePicturesWhenAsked) {
+  const std::string file = write_video();
+  VideoSource eager(file);
+  VideoSourceParams params;
+  params.defer_colour = true;
+  VideoSource deferred(file, params);
+  EXPECT_EQ(deferred.size(), kSize);
+  const auto a = read_all(eager);
+  const auto b = read_all(deferred);
+  expect_in_order(b, 0, kFrames);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_TRUE(b[i].image.empty());
+    ASSERT_TRUE(b[i].deferred_image);
+    const cv::Mat picture = b[i].picture();
+    ASSERT_EQ(picture.type(), CV_8UC3);
+    EXPECT_EQ(cv::norm(picture, a[i].image, cv::NORM_INF), 0) << "frame " << i;
+    EXPECT_EQ(cv::norm(b[i].gray, a[i].gray, cv::NORM_INF), 0) << "frame " << i;
+    EXPECT_EQ(a[i].picture().data, a[i].image.data);  // nothing deferred: the image itself
+  }
+
+  write_images("seq", "%04d.png");
+  VideoSource folder(path("seq"), params);
+  const auto frame = folder.next();
+  ASSERT_TRUE(frame);
+  EXPECT_FALSE(frame->deferred_image);
+  EXPECT_EQ(frame->image.type(), CV_8UC3);
+}
+
+// A DeferredImage is made once whoever asks, and a maker that throws leaves it to the next call.
+TEST(DeferredImageTest, MadeOnceAcrossThreadsAndRetriedAfterAFailure) {
+  std::atomic<int> made{0};
+  const DeferredImage once([&] {
+    ++made;
+    return cv::Mat(4, 4, CV_8UC3, cv::Scalar(1, 2, 3));
+  });
+  std::vector<std::thread> threads;
+  std::vector<cv::Mat> got(8);
+  for (std::size_t t = 0; t < got.size(); ++t)
+    threads.emplace_back([&, t] { got[t] = once.get(); });
+  for (std::thread& thread : threads)
+    thread.join();
+  EXPECT_EQ(made.load(), 1);
+  for (const cv::Mat& m : got)
+    EXPECT_EQ(m.data, got.front().data);
+
+  int calls = 0;
+  const DeferredImage flaky([&] {
+    if (++calls == 1) throw std::runtime_error("first call fails");
+    return cv::Mat(2, 2, CV_8UC1, cv::Scalar(9));
+  });
+  EXPECT_THROW(flaky.get(), std::runtime_error);
+  EXPECT_EQ(flaky.get().at<uchar>(1, 1), 9);
+  EXPECT_EQ(calls, 2);
+  EXPECT_EQ(picture_of(cv::Mat(), nullptr, cv::Mat(3, 3, CV_8UC1)).rows, 3);  // gray at last
 }
 
 TEST_F(VideoSourceTest, ReadsOtbFolderAtTheGivenFps) {

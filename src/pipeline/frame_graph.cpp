@@ -330,9 +330,9 @@ RunReport run_tracking(const FrameSource& source, const TrackStep& step,
       TrackedFrame out;
       out.seq = m.seq;
       out.frame = m.frame;
-      out.output = std::make_shared<const stages::TrackerOutput>(
-          step.process({m.frame->index, m.frame->image, m.frame->gray,
-                        std::const_pointer_cast<const flow::Pyramid>(m.pyramid)}));
+      out.output = std::make_shared<const stages::TrackerOutput>(step.process(
+          {m.frame->index, m.frame->image, m.frame->gray,
+           std::const_pointer_cast<const flow::Pyramid>(m.pyramid), m.frame->deferred_image}));
       run.time("track", t0);
       return out;
     });

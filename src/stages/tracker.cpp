@@ -220,12 +220,13 @@ struct Tracker::Impl {
   void observe(const TrackerInput& frame, double weight = 1.0, bool beside = false) {
     finish_refresh();
     if (params.init || observed_index == frame.index) return;
-    const cv::Mat image = frame.image.empty() ? frame.gray : frame.image;  // a job keeps it alive
     if (beside && executor != nullptr) {
+      // The job keeps the frame alive, and makes a deferred picture on its own thread.
       GlobalDetector* model = &detector;
-      refresh = executor->start([model, image, weight] { model->observe(image, weight); });
+      const TrackerInput in{frame.index, frame.image, frame.gray, nullptr, frame.deferred_image};
+      refresh = executor->start([model, in, weight] { model->observe(in.picture(), weight); });
     } else {
-      detector.observe(image, weight);
+      detector.observe(frame.picture(), weight);
     }
     observed_index = frame.index;
   }
@@ -233,7 +234,7 @@ struct Tracker::Impl {
 
 void Tracker::Impl::acquire(const TrackerInput& frame, TrackerOutput& out) {
   finish_refresh();
-  const cv::Mat& image = frame.image.empty() ? frame.gray : frame.image;
+  const cv::Mat image = frame.picture();
   if (params.init) {
     const cv::Rect2f& b = *params.init;
     const cv::Rect2f inside =
@@ -293,7 +294,7 @@ void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double
   finish_refresh();
   if (!global_mode) ++activations;
   out.mode = TrackRecord::Mode::Global;
-  const cv::Mat& image = frame.image.empty() ? frame.gray : frame.image;
+  const cv::Mat image = frame.picture();
   observe(frame);
   const bool by_appearance = params.init.has_value() || camera_moves;
   const std::optional<Detection> found =

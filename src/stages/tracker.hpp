@@ -8,8 +8,8 @@
 //     std::shared_ptr<flow::Pyramid> pyr;                   // optional: see wants_pyramid()
 //     if (tracker.wants_pyramid()) pyr = std::make_shared<flow::Pyramid>(flow::build_pyramid(
 //         f->gray, tracker.pyramid_levels(), tracker.pyramid_sigma()));
-//     stages::TrackerOutput out = tracker.process({f->index, f->image, f->gray, pyr});
-//     if (out.has_target) log.write(to_record(out));
+//     stages::TrackerOutput out = tracker.process({f->index, f->image, f->gray, pyr,
+//     f->deferred_image}); if (out.has_target) log.write(to_record(out));
 //   }
 //
 // Per frame, in order:
@@ -39,6 +39,7 @@
 #include "flow/dense_lk.hpp"
 #include "flow/executor.hpp"
 #include "flow/pyramid.hpp"
+#include "stages/deferred_image.hpp"
 #include "stages/global_detector.hpp"
 #include "stages/local_tracker.hpp"
 #include "stages/track_log.hpp"
@@ -83,9 +84,15 @@ struct TrackerParams {
 // builds pyramids of its region only); wants_pyramid() tells a pipeline when to build them.
 struct TrackerInput {
   long long index = 0;
-  cv::Mat image;                                 // as decoded, 8-bit BGR or gray
+  cv::Mat image;                                 // as decoded, 8-bit BGR or gray; may be empty
   cv::Mat gray;                                  // 8-bit gray
   std::shared_ptr<const flow::Pyramid> pyramid;  // optional
+  // Optional: the picture when `image` is empty, made only if the tracker needs colour for this
+  // frame (to learn the background or the target's appearance, or to search for it when lost).
+  // Without either, the tracker works on gray.
+  std::shared_ptr<const DeferredImage> deferred_image;
+
+  cv::Mat picture() const { return picture_of(image, deferred_image, gray); }
 };
 
 struct TrackerOutput {

@@ -59,6 +59,93 @@ bool full_range(const AVFrame& frame) {
          format == AV_PIX_FMT_YUVJ440P || format == AV_PIX_FMT_YUVJ411P;
 }
 
+// Converts frames of one pixel format, size and range to BGR, from any thread: each conversion
+// takes a swscale context nobody is using (a new one when all are busy) and a buffer of the pool
+// that nobody else holds. Shared by the decoder and the deferred pictures of its frames, so it
+// outlives whichever goes first.
+class BgrConverter {
+ public:
+  // Throws roiflow::Error when swscale has no conversion from `format` (checked here, at decode
+  // time, so that a deferred conversion cannot fail for that reason later).
+  BgrConverter(const std::string& path, AVPixelFormat format, cv::Size size, bool full,
+               std::size_t pool_limit)
+      : path_(path), format_(format), size_(size), full_(full), pool_limit_(pool_limit) {
+    idle_.push_back(make_context());
+  }
+  ~BgrConverter() {
+    for (SwsContext* c : idle_)
+      sws_freeContext(c);
+  }
+  BgrConverter(const BgrConverter&) = delete;
+  BgrConverter& operator=(const BgrConverter&) = delete;
+
+  bool fits(const AVFrame& frame) const {
+    return frame.format == format_ && frame.width == size_.width && frame.height == size_.height &&
+           full_range(frame) == full_;
+  }
+
+  cv::Mat convert(const AVFrame& frame) {
+    SwsContext* context = nullptr;
+    cv::Mat bgr;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!idle_.empty()) {
+        context = idle_.back();
+        idle_.pop_back();
+      }
+      bgr = take_locked(CV_8UC3);
+    }
+    if (context == nullptr) context = make_context();
+    uint8_t* dst[4] = {bgr.data, nullptr, nullptr, nullptr};
+    const int dst_stride[4] = {static_cast<int>(bgr.step), 0, 0, 0};
+    sws_scale(context, frame.data, frame.linesize, 0, size_.height, dst, dst_stride);
+    std::lock_guard<std::mutex> lock(mutex_);
+    idle_.push_back(context);
+    return bgr;
+  }
+
+ private:
+  // A buffer of the pool that nobody else holds (refcount 1: the pool's own reference, read
+  // atomically, so no other thread can be using it), or a new one. Callers hold the mutex.
+  cv::Mat take_locked(int type) {
+    for (const cv::Mat& m : pool_) {
+      if (m.type() == type && m.u != nullptr && CV_XADD(&m.u->refcount, 0) == 1) return m;
+    }
+    cv::Mat m(size_, type);
+    if (pool_.size() < pool_limit_) pool_.push_back(m);
+    return m;
+  }
+
+  SwsContext* make_context() const {
+    const int w = size_.width, h = size_.height;
+    // SWS_BICUBIC as OpenCV's backend asks (same size: it only picks the chroma filter).
+    SwsContext* context = sws_getContext(w, h, format_, w, h, AV_PIX_FMT_BGR24, SWS_BICUBIC,
+                                         nullptr, nullptr, nullptr);
+    if (context == nullptr)
+      throw Error("video '" + path_ + "': no conversion from pixel format " +
+                  (av_get_pix_fmt_name(format_) ? av_get_pix_fmt_name(format_) : "?") + " to BGR");
+    int* inv = nullptr;
+    int* table = nullptr;
+    int src_range = 0, dst_range = 0, brightness = 0, contrast = 0, saturation = 0;
+    if (sws_getColorspaceDetails(context, &inv, &src_range, &table, &dst_range, &brightness,
+                                 &contrast, &saturation) >= 0 &&
+        src_range != static_cast<int>(full_)) {
+      sws_setColorspaceDetails(context, inv, full_ ? 1 : 0, table, dst_range, brightness, contrast,
+                               saturation);
+    }
+    return context;
+  }
+
+  std::string path_;
+  AVPixelFormat format_;
+  cv::Size size_;
+  bool full_;
+  std::size_t pool_limit_;
+  std::mutex mutex_;
+  std::vector<SwsContext*> idle_;
+  std::vector<cv::Mat> pool_;
+};
+
 }  // namespace
 
 struct VideoDecoder::Impl {
@@ -67,10 +154,9 @@ struct VideoDecoder::Impl {
   AVCodecContext* codec = nullptr;
   AVPacket* packet = nullptr;
   AVFrame* frame = nullptr;
-  SwsContext* sws = nullptr;
-  int sws_format = -1;  // the source format and size `sws` was made for
-  cv::Size sws_size;
-  bool sws_full_range = false;
+  bool defer_bgr = false;
+  std::shared_ptr<BgrConverter> converter;  // for the current format; null before the first frame
+  cv::Size frame_size;                      // the first frame's
   int stream = -1;
   double fps = 0;
   long long frame_count = -1;
@@ -78,11 +164,10 @@ struct VideoDecoder::Impl {
   int64_t start_pts = 0;
   bool draining = false;  // the demuxer is done; the decoder gives what it still holds
   bool ended = false;
-  std::vector<cv::Mat> bgr_pool, gray_pool;
+  std::vector<cv::Mat> gray_pool;
   std::size_t pool_limit = 4;
 
   ~Impl() {
-    sws_freeContext(sws);
     av_frame_free(&frame);
     av_packet_free(&packet);
     avcodec_free_context(&codec);
@@ -139,40 +224,27 @@ struct VideoDecoder::Impl {
   void convert(DecodedFrame& out) {
     const int w = frame->width, h = frame->height;
     // Checked before any buffer of the new size is allocated (a damaged stream may claim any).
-    if (!sws_size.empty() && sws_size != cv::Size(w, h)) {
+    if (frame_size.empty()) frame_size = cv::Size(w, h);
+    if (frame_size != cv::Size(w, h)) {
       throw Error("video '" + path + "': the frame size changed from " +
-                  std::to_string(sws_size.width) + "x" + std::to_string(sws_size.height) + " to " +
-                  std::to_string(w) + "x" + std::to_string(h) + " mid-stream");
+                  std::to_string(frame_size.width) + "x" + std::to_string(frame_size.height) +
+                  " to " + std::to_string(w) + "x" + std::to_string(h) + " mid-stream");
     }
     const auto source_format = static_cast<AVPixelFormat>(frame->format);
     const bool full = full_range(*frame);
-    if (sws == nullptr || sws_format != frame->format || sws_full_range != full) {
-      sws_freeContext(sws);
-      // SWS_BICUBIC as OpenCV's backend asks (same size: it only picks the chroma filter).
-      sws = sws_getContext(w, h, source_format, w, h, AV_PIX_FMT_BGR24, SWS_BICUBIC, nullptr,
-                           nullptr, nullptr);
-      if (sws == nullptr)
-        throw Error(
-            "video '" + path + "': no conversion from pixel format " +
-            (av_get_pix_fmt_name(source_format) ? av_get_pix_fmt_name(source_format) : "?") +
-            " to BGR");
-      int* inv = nullptr;
-      int* table = nullptr;
-      int src_range = 0, dst_range = 0, brightness = 0, contrast = 0, saturation = 0;
-      if (sws_getColorspaceDetails(sws, &inv, &src_range, &table, &dst_range, &brightness,
-                                   &contrast, &saturation) >= 0 &&
-          src_range != static_cast<int>(full)) {
-        sws_setColorspaceDetails(sws, inv, full ? 1 : 0, table, dst_range, brightness, contrast,
-                                 saturation);
-      }
-      sws_format = frame->format;
-      sws_size = cv::Size(w, h);
-      sws_full_range = full;
+    if (!converter || !converter->fits(*frame))
+      converter = std::make_shared<BgrConverter>(path, source_format, frame_size, full, pool_limit);
+    out.deferred_bgr.reset();
+    if (defer_bgr && luma_is_plane0(source_format)) {
+      // The planes are kept (a reference, no copy) until somebody asks for the picture.
+      std::shared_ptr<AVFrame> planes(av_frame_clone(frame), [](AVFrame* f) { av_frame_free(&f); });
+      if (!planes) throw Error("video '" + path + "': out of memory");
+      out.bgr.release();
+      out.deferred_bgr = std::make_shared<const DeferredImage>(
+          [c = converter, planes] { return c->convert(*planes); });
+    } else {
+      out.bgr = converter->convert(*frame);
     }
-    out.bgr = take(bgr_pool, h, w, CV_8UC3);
-    uint8_t* dst[4] = {out.bgr.data, nullptr, nullptr, nullptr};
-    const int dst_stride[4] = {static_cast<int>(out.bgr.step), 0, 0, 0};
-    sws_scale(sws, frame->data, frame->linesize, 0, h, dst, dst_stride);
 
     out.gray = take(gray_pool, h, w, CV_8UC1);
     if (luma_is_plane0(source_format)) {
@@ -194,10 +266,12 @@ struct VideoDecoder::Impl {
   }
 };
 
-VideoDecoder::VideoDecoder(const std::string& path, int threads) : impl_(std::make_unique<Impl>()) {
+VideoDecoder::VideoDecoder(const std::string& path, int threads, bool defer_bgr)
+    : impl_(std::make_unique<Impl>()) {
   apply_log_level();
   Impl& d = *impl_;
   d.path = path;
+  d.defer_bgr = defer_bgr;
   const std::string label = "video '" + path + "'";
   if (threads < 0)
     throw Error(label + ": decoder threads must be >= 0, got " + std::to_string(threads));

@@ -17,6 +17,11 @@
 // a small pool of buffers that are reused once nobody else holds them (no page faults per
 // frame).
 //
+// Deferred colour: with `defer_bgr`, frames of formats whose plane 0 is the luma (all YUV ones)
+// come with an empty `bgr` and a DeferredImage that converts them on the thread that first asks
+// (a swscale context and buffer pool shared with the decoder, thread-safe); the gray frame is
+// always made at once. Other formats (RGB, palette) are converted at once as before.
+//
 // Decoder threads: `threads` > 0 asks FFmpeg for that many; 0 picks one thread for frames of
 // up to kSingleThreadPixels (where FFmpeg's frame threads cost more than they give: synthetic
 // 640x480 MPEG-4, 3850 frames/s on one thread vs 2370-2940 on two or three) and FFmpeg's own
@@ -35,10 +40,15 @@
 #include <opencv2/core.hpp>
 #include <string>
 
+#include "stages/deferred_image.hpp"
+
 namespace roiflow::stages {
 
 struct DecodedFrame {
-  cv::Mat bgr;   // 8-bit, 3 channels
+  cv::Mat bgr;  // 8-bit, 3 channels; empty when `deferred_bgr` holds it
+  // With defer_bgr, the BGR picture converted when first asked for (from any thread; the
+  // decoder's planes are held until then). Null when `bgr` is set.
+  std::shared_ptr<const DeferredImage> deferred_bgr;
   cv::Mat gray;  // 8-bit, 1 channel, the same size
   // Presentation time in seconds from the stream's start, or a negative value when the
   // container gives none for this frame.
@@ -49,7 +59,7 @@ class VideoDecoder {
  public:
   static constexpr long long kSingleThreadPixels = 1280LL * 720;
 
-  explicit VideoDecoder(const std::string& path, int threads = 0);
+  explicit VideoDecoder(const std::string& path, int threads = 0, bool defer_bgr = false);
   ~VideoDecoder();
   VideoDecoder(const VideoDecoder&) = delete;
   VideoDecoder& operator=(const VideoDecoder&) = delete;

@@ -31,8 +31,8 @@ namespace roiflow::stages {
 class VideoSource::Reader {
  public:
   virtual ~Reader() = default;
-  virtual bool read(long long index, cv::Mat& image, cv::Mat& gray, double& timestamp_s,
-                    std::string& failure) = 0;
+  // Fills `frame`'s image (or deferred_image), timestamp and, optionally, gray.
+  virtual bool read(long long index, Frame& frame, std::string& failure) = 0;
   virtual double fps() const = 0;
   virtual long long frame_count() const = 0;  // from index 0; -1 when unknown
   virtual std::string description() const = 0;
@@ -242,8 +242,7 @@ class SequenceReader : public VideoSource::Reader {
            " not read)";
   }
 
-  bool read(long long index, cv::Mat& image, cv::Mat&, double& timestamp_s,
-            std::string& failure) override {
+  bool read(long long index, Frame& frame, std::string& failure) override {
     if (index >= static_cast<long long>(paths_.size())) {
       failure = gap_;
       return false;
@@ -256,12 +255,12 @@ class SequenceReader : public VideoSource::Reader {
       return false;
     }
     try {
-      image = read_image(path, cv::IMREAD_ANYCOLOR);
+      frame.image = read_image(path, cv::IMREAD_ANYCOLOR);
     } catch (const Error& e) {
       failure = e.what();
       return false;
     }
-    timestamp_s = static_cast<double>(index) / fps_;
+    frame.timestamp_s = static_cast<double>(index) / fps_;
     return true;
   }
 
@@ -291,13 +290,12 @@ class CameraReader : public VideoSource::Reader {
     opened_at_ = std::chrono::steady_clock::now();
   }
 
-  bool read(long long, cv::Mat& image, cv::Mat&, double& timestamp_s,
-            std::string& failure) override {
-    if (!capture_.read(image) || image.empty()) {
+  bool read(long long, Frame& frame, std::string& failure) override {
+    if (!capture_.read(frame.image) || frame.image.empty()) {
       failure = label_ + " stopped delivering frames";
       return false;
     }
-    timestamp_s =
+    frame.timestamp_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - opened_at_).count();
     return true;
   }
@@ -317,32 +315,32 @@ class CameraReader : public VideoSource::Reader {
 
 class VideoFileReader : public VideoSource::Reader {
  public:
-  VideoFileReader(const std::string& path, double default_fps, int threads)
-      : label_("video " + quoted(path)), decoder_(path, threads) {
+  VideoFileReader(const std::string& path, double default_fps, int threads, bool defer_colour)
+      : label_("video " + quoted(path)), decoder_(path, threads, defer_colour) {
     // Checked before the first frame is decoded: a huge frame would be allocated by then.
     const cv::Size announced = decoder_.size();
     if (announced.width > 0 && announced.height > 0) check_frame_size(announced, label_);
     fps_ = decoder_.fps() > 0 ? decoder_.fps() : default_fps;
   }
 
-  bool read(long long index, cv::Mat& image, cv::Mat& gray, double& timestamp_s,
-            std::string& failure) override {
+  bool read(long long index, Frame& out, std::string& failure) override {
     DecodedFrame frame;
     std::string error;
     if (!decoder_.read(frame, error)) {
       failure = end_failure(index, error);
       return false;
     }
-    image = frame.bgr;
-    gray = frame.gray;
+    out.image = frame.bgr;
+    out.deferred_image = frame.deferred_bgr;
+    out.gray = frame.gray;
     // Containers without timestamps give none (or repeat the last one): fall back to the
     // frame rate so timestamps always increase.
     const double pts = frame.timestamp_s;
     const bool usable = std::isfinite(pts) && (last_timestamp_ ? pts > *last_timestamp_ : pts >= 0);
-    timestamp_s = usable            ? pts
-                  : last_timestamp_ ? *last_timestamp_ + 1.0 / fps_
-                                    : static_cast<double>(index) / fps_;
-    last_timestamp_ = timestamp_s;
+    out.timestamp_s = usable            ? pts
+                      : last_timestamp_ ? *last_timestamp_ + 1.0 / fps_
+                                        : static_cast<double>(index) / fps_;
+    last_timestamp_ = out.timestamp_s;
     return true;
   }
 
@@ -394,14 +392,14 @@ class SyntheticReader : public VideoSource::Reader {
   SyntheticReader(long long frames, cv::Size size, double fps)
       : frames_(frames), fps_(fps), scene_(scene_params(size)) {}
 
-  bool read(long long index, cv::Mat& image, cv::Mat&, double& timestamp_s, std::string&) override {
+  bool read(long long index, Frame& frame, std::string&) override {
     if (index >= frames_) return false;
     // Mirrored so that the vehicle turns back instead of leaping to the start: the only jumps
     // are the scene's own, which the tracker's global treatment has to catch.
     const long long period = 2 * (kSceneFrames - 1);
     const long long phase = index % period;
-    image = scene_.render(static_cast<int>(phase < kSceneFrames ? phase : period - phase));
-    timestamp_s = static_cast<double>(index) / fps_;
+    frame.image = scene_.render(static_cast<int>(phase < kSceneFrames ? phase : period - phase));
+    frame.timestamp_s = static_cast<double>(index) / fps_;
     return true;
   }
 
@@ -470,7 +468,7 @@ int camera_index(const std::string& input) {
 }
 
 std::unique_ptr<VideoSource::Reader> open_reader(const std::string& input, double fps,
-                                                 int decode_threads) {
+                                                 int decode_threads, bool defer_colour) {
   if (input.empty()) throw Error("no input given: expected a video file, a folder or a camera");
   if (const int camera = camera_index(input); camera >= 0)
     return std::make_unique<CameraReader>(camera, fps);
@@ -486,7 +484,8 @@ std::unique_ptr<VideoSource::Reader> open_reader(const std::string& input, doubl
     throw Error("no image sequence in " + quoted(input) +
                 " or its img/ folder: expected numbered images like 0001.jpg");
   }
-  if (fs::exists(status)) return std::make_unique<VideoFileReader>(input, fps, decode_threads);
+  if (fs::exists(status))
+    return std::make_unique<VideoFileReader>(input, fps, decode_threads, defer_colour);
   if (input.starts_with(kSyntheticPrefix)) return open_synthetic(input, fps);
   if (input.find('%') != std::string::npos) {
     const Pattern pattern = parse_pattern(input);
@@ -527,14 +526,13 @@ VideoSource::VideoSource(const std::string& input, const VideoSourceParams& para
     throw Error("max_frames must be >= 0, got " + std::to_string(params.max_frames));
   if (params.decode_threads < 0)
     throw Error("decode_threads must be >= 0, got " + std::to_string(params.decode_threads));
-  reader_ = open_reader(input, params.fps, params.decode_threads);
+  reader_ = open_reader(input, params.fps, params.decode_threads, params.defer_colour);
 
-  cv::Mat skipped, skipped_gray;
-  double timestamp_s = 0;
   std::string failure;
   for (long long index = 0; index < params.start; ++index) {
     // Reading (rather than seeking) keeps the frame exact whatever the codec's key frames.
-    if (!reader_->read(index, skipped, skipped_gray, timestamp_s, failure))
+    Frame skipped;
+    if (!reader_->read(index, skipped, failure))
       throw Error("start " + std::to_string(params.start) + " is past the end of " + quoted(input) +
                   ": no frame " + std::to_string(index) +
                   (failure.empty() ? "" : " (" + failure + ")"));
@@ -545,7 +543,7 @@ VideoSource::VideoSource(const std::string& input, const VideoSourceParams& para
   if (!pending_)
     throw Error("cannot read the first frame of " + quoted(input) + ": " +
                 (failure.empty() ? "no frame in it" : failure));
-  size_ = pending_->image.size();
+  size_ = pending_->gray.size();
 }
 
 VideoSource::~VideoSource() = default;
@@ -578,27 +576,29 @@ std::optional<Frame> VideoSource::next() {
 std::optional<Frame> VideoSource::read_frame(long long index, std::string& failure) {
   Frame frame;
   frame.index = index;
-  if (!reader_->read(index, frame.image, frame.gray, frame.timestamp_s, failure))
-    return std::nullopt;
-  if (frame.image.depth() != CV_8U ||
-      (frame.image.channels() != 1 && frame.image.channels() != 3)) {
+  if (!reader_->read(index, frame, failure)) return std::nullopt;
+  // A deferred picture is BGR of the gray frame's size (the decoder makes both).
+  const bool deferred = frame.image.empty() && frame.deferred_image && !frame.gray.empty();
+  const cv::Mat& checked = deferred ? frame.gray : frame.image;
+  if (!deferred && (frame.image.depth() != CV_8U ||
+                    (frame.image.channels() != 1 && frame.image.channels() != 3))) {
     failure = "unsupported pixel format (OpenCV type " + std::to_string(frame.image.type()) +
               "): expected 8-bit gray or BGR";
     return std::nullopt;
   }
   if (size_.empty()) {
     // The first frame: checked before a gray copy of a huge image is made.
-    failure = frame_size_problem(frame.image.size());
+    failure = frame_size_problem(checked.size());
     if (!failure.empty()) {
       failure = "frame size " + failure;
       return std::nullopt;
     }
-  } else if (frame.image.size() != size_) {
-    failure = "frame size " + size_string(frame.image.size()) + " differs from the first frame's " +
+  } else if (checked.size() != size_) {
+    failure = "frame size " + size_string(checked.size()) + " differs from the first frame's " +
               size_string(size_);
     return std::nullopt;
   }
-  if (frame.image.channels() == 1)
+  if (!deferred && frame.image.channels() == 1)
     frame.gray = frame.image;
   else if (frame.gray.empty())
     cv::cvtColor(frame.image, frame.gray, cv::COLOR_BGR2GRAY);

@@ -64,6 +64,7 @@
 #include <string>
 
 #include "flow/pyramid.hpp"
+#include "stages/deferred_image.hpp"
 
 namespace roiflow::stages {
 
@@ -89,7 +90,12 @@ struct VideoSourceParams {
                              // the earlier ones (exact whatever the key frames, not instant)
   long long max_frames = 0;  // at most this many frames are delivered; 0 = all
   int decode_threads = 0;    // a video's FFmpeg decoder threads; 0 = automatic (see
-                             // VideoDecoder); >= 0
+                             // VideoDecoder); >= 0  // A video's frames come with `image` empty and
+                             // their BGR picture in `deferred_image`,
+  // converted from the decoder's planes only when Frame::picture() first asks for it (on the
+  // asking thread): for pipelines that need the gray frame only, or colour for a few frames
+  // (tracking without a video sink: 40 % of decoding saved). Other inputs ignore it.
+  bool defer_colour = false;
 };
 
 struct Frame {
@@ -98,8 +104,13 @@ struct Frame {
   // increases, else the previous one + 1/fps), index / fps for image sequences, and the
   // wall-clock time since opening for cameras.
   double timestamp_s = 0;
-  cv::Mat image;  // as decoded: 8-bit BGR or 8-bit gray
+  cv::Mat image;  // as decoded: 8-bit BGR or 8-bit gray; empty when `deferred_image` holds it
   cv::Mat gray;   // 8-bit gray, the same size; shares `image`'s data when that is gray
+  std::shared_ptr<const DeferredImage> deferred_image;  // see VideoSourceParams::defer_colour
+
+  // The picture as decoded (BGR or gray): `image`, else the deferred one (converted now, once;
+  // thread-safe), else `gray`.
+  cv::Mat picture() const { return picture_of(image, deferred_image, gray); }
 };
 
 struct SourceStatus {
