@@ -65,10 +65,12 @@ struct TrackerParams {
   // `observe_interval` frames while the local treatment holds the target (every frame while the
   // global treatment searches, and on the frame the target is lost). It only has to stay
   // current enough for a later re-detection; refreshing it every frame would cost several times
-  // the local treatment itself (MOG2 on a 320x240 copy: ~2 ms; every 16th frame it was still a
-  // fifth of the local treatment's instructions, and it competes with decoding for the other
-  // core). 1..1000.
-  int observe_interval = 32;
+  // the local treatment itself (MOG2 on a 320x240 copy: ~2 ms, plus the frame's colour
+  // conversion). It runs beside the frames, but on two cores it takes the time of decoding or
+  // tracking all the same: every 32nd frame it cost a fifth of tracking's frames/s at 640x480
+  // (pipeline_bench TrackVsDecode: 2.3-2.6k frames/s, 2.9-3.0k at 64; demo, vtest and
+  // bgslibrary re-detections unchanged). 1..1000.
+  int observe_interval = 64;
   // While the target is held, each refresh learns as much as observe_interval x held_learning
   // frames of video: the model forgets more slowly than while searching (1 / held_learning times
   // its history), so that a slow target it sees in every refresh is not learnt into the
