@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The concurrency tests under ThreadSanitizer: the flow-graph, stripe-executor, tracker,
-# cancellation and soak tests (the tsan test preset's filter), against a oneTBB built with TSan.
+# cancellation and soak tests, and the video decoder's and DeferredImage's (colour converted on
+# whichever thread asks first) (the tsan test preset's filter), against a oneTBB built with TSan.
 #
 #   scripts/tsan.sh
 #

@@ -12,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 #include <random>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "flow/dense_lk.hpp"
@@ -218,18 +219,41 @@ TEST_P(FrameGraphThreads, TheTrackerGivesTheSerialResult) {
   }
   ASSERT_GE(serial.back().global_activations, 2);  // detection, and the jump
 
+  // Through the graph the frames come with their colour deferred, as the CLI reads a video: the
+  // tracker's refresh jobs and a sink ask for it on different threads.
   int next = 0;
   TbbExecutor tiles;
   stages::Tracker tracker(params, &tiles);
   std::vector<stages::TrackerOutput> piped;
+  std::atomic<int> made{0};
+  long long pictures_checked = 0;
   GraphOptions options;
   options.threads = GetParam();
   run_tracking(
       [&]() -> std::optional<stages::Frame> {
         if (next >= scene.frames()) return std::nullopt;
-        return frame(next++);
+        stages::Frame f = frame(next++);
+        const cv::Mat bgr = std::exchange(f.image, cv::Mat());
+        f.deferred_image = std::make_shared<const stages::DeferredImage>([bgr, &made] {
+          ++made;
+          return bgr.clone();
+        });
+        return f;
       },
-      tracker, {{"collect", [&](const TrackedFrame& f) { piped.push_back(*f.output); }}}, options);
+      tracker,
+      {{"collect", [&](const TrackedFrame& f) { piped.push_back(*f.output); }},
+       {"picture",
+        [&](const TrackedFrame& f) {
+          if (f.seq % 3 != 0) return;
+          const cv::Mat picture = f.frame->picture();
+          EXPECT_EQ(cv::norm(picture, scene.render(static_cast<int>(f.frame->index)), cv::NORM_INF),
+                    0)
+              << "frame " << f.frame->index;
+          ++pictures_checked;
+        }}},
+      options);
+  EXPECT_EQ(pictures_checked, (scene.frames() + 2) / 3);
+  EXPECT_LT(made.load(), scene.frames());  // the frames nobody asked for were never converted
   ASSERT_EQ(piped.size(), serial.size());
   for (std::size_t i = 0; i < serial.size(); ++i) {
     EXPECT_EQ(piped[i].box, serial[i].box) << "frame " << i;

@@ -166,34 +166,6 @@ TEST_F(VideoSourceTest, DeferredColourGivesTheSamePicturesWhenAsked) {
   EXPECT_EQ(frame->image.type(), CV_8UC3);
 }
 
-// A DeferredImage is made once whoever asks, and a maker that throws leaves it to the next call.
-TEST(DeferredImageTest, MadeOnceAcrossThreadsAndRetriedAfterAFailure) {
-  std::atomic<int> made{0};
-  const DeferredImage once([&] {
-    ++made;
-    return cv::Mat(4, 4, CV_8UC3, cv::Scalar(1, 2, 3));
-  });
-  std::vector<std::thread> threads;
-  std::vector<cv::Mat> got(8);
-  for (std::size_t t = 0; t < got.size(); ++t)
-    threads.emplace_back([&, t] { got[t] = once.get(); });
-  for (std::thread& thread : threads)
-    thread.join();
-  EXPECT_EQ(made.load(), 1);
-  for (const cv::Mat& m : got)
-    EXPECT_EQ(m.data, got.front().data);
-
-  int calls = 0;
-  const DeferredImage flaky([&] {
-    if (++calls == 1) throw std::runtime_error("first call fails");
-    return cv::Mat(2, 2, CV_8UC1, cv::Scalar(9));
-  });
-  EXPECT_THROW(flaky.get(), std::runtime_error);
-  EXPECT_EQ(flaky.get().at<uchar>(1, 1), 9);
-  EXPECT_EQ(calls, 2);
-  EXPECT_EQ(picture_of(cv::Mat(), nullptr, cv::Mat(3, 3, CV_8UC1)).rows, 3);  // gray at last
-}
-
 TEST_F(VideoSourceTest, ReadsOtbFolderAtTheGivenFps) {
   write_images("Car/img", "%04d.jpg");
   write_bytes(path("Car/groundtruth_rect.txt"), "1,2,3,4\n");
