@@ -8,8 +8,9 @@
 //     std::shared_ptr<flow::Pyramid> pyr;                   // optional: see wants_pyramid()
 //     if (tracker.wants_pyramid()) pyr = std::make_shared<flow::Pyramid>(flow::build_pyramid(
 //         f->gray, tracker.pyramid_levels(), tracker.pyramid_sigma()));
-//     stages::TrackerOutput out = tracker.process({f->index, f->image, f->gray, pyr,
-//     f->deferred_image}); if (out.has_target) log.write(to_record(out));
+//     stages::TrackerOutput out =
+//         tracker.process({f->index, f->image, f->gray, pyr, f->deferred_image});
+//     if (out.has_target) log.write(to_record(out));
 //   }
 //
 // Per frame, in order:
@@ -68,8 +69,8 @@ struct TrackerParams {
   // the local treatment itself (MOG2 on a 320x240 copy: ~2 ms, plus the frame's colour
   // conversion). It runs beside the frames, but on two cores it takes the time of decoding or
   // tracking all the same: every 32nd frame it cost a fifth of tracking's frames/s at 640x480
-  // (pipeline_bench TrackVsDecode: 2.3-2.6k frames/s, 2.9-3.0k at 64; demo, vtest and
-  // bgslibrary re-detections unchanged). 1..1000.
+  // (pipeline_bench TrackVsDecode: 2.3-2.6k frames/s, 2.9-3.0k at 64; the demo's AUC
+  // unchanged, global activations vtest 11 -> 8, bgslibrary 8 -> 9). 1..1000.
   int observe_interval = 64;
   // While the target is held, each refresh learns as much as observe_interval x held_learning
   // frames of video: the model forgets more slowly than while searching (1 / held_learning times

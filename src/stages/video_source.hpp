@@ -90,8 +90,8 @@ struct VideoSourceParams {
                              // the earlier ones (exact whatever the key frames, not instant)
   long long max_frames = 0;  // at most this many frames are delivered; 0 = all
   int decode_threads = 0;    // a video's FFmpeg decoder threads; 0 = automatic (see
-                             // VideoDecoder); >= 0  // A video's frames come with `image` empty and
-                             // their BGR picture in `deferred_image`,
+                             // VideoDecoder); >= 0
+  // A video's frames come with `image` empty and their BGR picture in `deferred_image`,
   // converted from the decoder's planes only when Frame::picture() first asks for it (on the
   // asking thread): for pipelines that need the gray frame only, or colour for a few frames
   // (tracking without a video sink: 40 % of decoding saved). Other inputs ignore it.
