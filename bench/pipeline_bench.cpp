@@ -117,9 +117,9 @@ stages::VideoSourceParams as_the_cli() {
   return params;
 }
 
-// One decode-only pass over the file: its frame count.
-long long decode_all(const std::string& path) {
-  stages::VideoSource source(path);
+// One decode-only pass over the file read with `params`: its frame count.
+long long decode_pass(const std::string& path, const stages::VideoSourceParams& params) {
+  stages::VideoSource source(path, params);
   long long frames = 0;
   while (auto f = source.next()) {
     benchmark::DoNotOptimize(f->image.data);
@@ -129,15 +129,14 @@ long long decode_all(const std::string& path) {
   return frames;
 }
 
-// One decode-only pass with colour deferred and never asked for: its frame count.
+// Every frame as BGR and gray.
+long long decode_all(const std::string& path) {
+  return decode_pass(path, {});
+}
+
+// Colour deferred and never asked for: the gray frames only.
 long long decode_all_gray(const std::string& path) {
-  stages::VideoSource source(path, as_the_cli());
-  long long frames = 0;
-  while (auto f = source.next()) {
-    benchmark::DoNotOptimize(f->gray.data);
-    ++frames;
-  }
-  return frames;
+  return decode_pass(path, as_the_cli());
 }
 
 // One decode-only pass with OpenCV's VideoCapture (BGR, then gray): its frame count.

@@ -59,6 +59,19 @@ bool full_range(const AVFrame& frame) {
          format == AV_PIX_FMT_YUVJ440P || format == AV_PIX_FMT_YUVJ411P;
 }
 
+// A buffer of `pool` that nobody else holds (refcount 1: the pool's own reference, read
+// atomically, so no other thread can be using it), or a new one, kept in the pool while it holds
+// fewer than `limit`. The caller owns the pool (one thread at a time).
+cv::Mat take(std::vector<cv::Mat>& pool, cv::Size size, int type, std::size_t limit) {
+  for (const cv::Mat& m : pool) {
+    if (m.size() == size && m.type() == type && m.u != nullptr && CV_XADD(&m.u->refcount, 0) == 1)
+      return m;
+  }
+  cv::Mat m(size, type);
+  if (pool.size() < limit) pool.push_back(m);
+  return m;
+}
+
 // Converts frames of one pixel format, size and range to BGR, from any thread: each conversion
 // takes a swscale context nobody is using (a new one when all are busy) and a buffer of the pool
 // that nobody else holds. Shared by the decoder and the deferred pictures of its frames, so it
@@ -93,7 +106,7 @@ class BgrConverter {
         context = idle_.back();
         idle_.pop_back();
       }
-      bgr = take_locked(CV_8UC3);
+      bgr = take(pool_, size_, CV_8UC3, pool_limit_);
     }
     if (context == nullptr) context = make_context();
     uint8_t* dst[4] = {bgr.data, nullptr, nullptr, nullptr};
@@ -105,17 +118,6 @@ class BgrConverter {
   }
 
  private:
-  // A buffer of the pool that nobody else holds (refcount 1: the pool's own reference, read
-  // atomically, so no other thread can be using it), or a new one. Callers hold the mutex.
-  cv::Mat take_locked(int type) {
-    for (const cv::Mat& m : pool_) {
-      if (m.type() == type && m.u != nullptr && CV_XADD(&m.u->refcount, 0) == 1) return m;
-    }
-    cv::Mat m(size_, type);
-    if (pool_.size() < pool_limit_) pool_.push_back(m);
-    return m;
-  }
-
   SwsContext* make_context() const {
     const int w = size_.width, h = size_.height;
     // SWS_BICUBIC as OpenCV's backend asks (same size: it only picks the chroma filter).
@@ -142,8 +144,8 @@ class BgrConverter {
   bool full_;
   std::size_t pool_limit_;
   std::mutex mutex_;
-  std::vector<SwsContext*> idle_;
-  std::vector<cv::Mat> pool_;
+  std::vector<SwsContext*> idle_;  // guarded by mutex_
+  std::vector<cv::Mat> pool_;      // guarded by mutex_
 };
 
 }  // namespace
@@ -172,19 +174,6 @@ struct VideoDecoder::Impl {
     av_packet_free(&packet);
     avcodec_free_context(&codec);
     avformat_close_input(&format);
-  }
-
-  // A buffer of the pool that nobody else holds (refcount 1: the pool's own reference, read
-  // atomically, so no other thread can be using it), or a new one.
-  cv::Mat take(std::vector<cv::Mat>& pool, int rows, int cols, int type) const {
-    for (const cv::Mat& m : pool) {
-      if (m.rows == rows && m.cols == cols && m.type() == type && m.u != nullptr &&
-          CV_XADD(&m.u->refcount, 0) == 1)
-        return m;
-    }
-    cv::Mat m(rows, cols, type);
-    if (pool.size() < pool_limit) pool.push_back(m);
-    return m;
   }
 
   // Fills `frame` with the next decoded picture: 0, AVERROR_EOF at the end, or an error.
@@ -246,7 +235,7 @@ struct VideoDecoder::Impl {
       out.bgr = converter->convert(*frame);
     }
 
-    out.gray = take(gray_pool, h, w, CV_8UC1);
+    out.gray = take(gray_pool, frame_size, CV_8UC1, pool_limit);
     if (luma_is_plane0(source_format)) {
       const cv::Mat luma(h, w, CV_8UC1, frame->data[0],
                          static_cast<std::size_t>(frame->linesize[0]));
