@@ -9,7 +9,7 @@
 #include <opencv2/imgproc.hpp>
 #include <string>
 
-#include "flow/error.hpp"
+#include "core/error.hpp"
 
 namespace roiflow::flow {
 

@@ -10,7 +10,7 @@
 #include <tuple>
 #include <unordered_map>
 
-#include "flow/error.hpp"
+#include "core/error.hpp"
 #include "pipeline/tbb_executor.hpp"
 
 namespace roiflow::pipeline {
