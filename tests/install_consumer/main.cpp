@@ -12,13 +12,14 @@
 int main() {
   using namespace roiflow;
   const flow::Scene scene = flow::make_translation({160, 120}, {1.25f, -0.5f});
-  flow::FlowOptions options;
 #ifdef CONSUMER_WITH_PIPELINE
-  const pipeline::TbbExecutor executor;
-  options.executor = &executor;
+  const pipeline::TbbExecutor tbb;
+  const flow::Executor* executor = &tbb;
+#else
+  const flow::Executor* executor = nullptr;
 #endif
-  const flow::FlowResult result =
-      flow::dense_flow(scene.frame0, scene.frame1, flow::LkParams::paper(), options);
+  flow::DenseLK lk(flow::LkParams::paper(), executor);
+  const flow::FlowResult result = lk.calc(scene.frame0, scene.frame1);
   const flow::FlowErrors errors = flow::flow_errors(result.flow, scene.flow);
   std::printf("installed roiflow: EPE %.4f px over %lld pixels\n", errors.epe,
               static_cast<long long>(errors.pixels));
