@@ -122,10 +122,9 @@ void run_flow(const FlowCommand& cmd) {
 
   const pipeline::TbbExecutor executor;
   flow::FlowOptions options;
-  options.executor = &executor;
   const auto start = std::chrono::steady_clock::now();
   const flow::FlowResult result = pipeline::run_with_threads(
-      cmd.lk.threads, [&] { return flow::dense_flow(frame0, frame1, params, options); });
+      cmd.lk.threads, [&] { return flow::dense_flow(frame0, frame1, params, options, &executor); });
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   // Scored before writing so that a failure here leaves no output behind.

@@ -512,9 +512,8 @@ EvalRow evaluate_pair(const EvalPair& pair, const flow::LkParams& params, const 
   }
 
   flow::FlowOptions options;
-  options.executor = executor;
   const auto start = std::chrono::steady_clock::now();
-  const flow::FlowResult result = flow::dense_flow(frame0, frame1, params, options);
+  const flow::FlowResult result = flow::dense_flow(frame0, frame1, params, options, executor);
   const auto stop = std::chrono::steady_clock::now();
 
   EvalRow row;
