@@ -1,34 +1,52 @@
 #!/usr/bin/env bash
-# Accuracy gates on the Middlebury "other" training set with ground truth: fails when the mean
-# EPE or AAE of a preset rises above its gate. Gates are the values measured when they were
-# set (README, "Accuracy") plus about 4 %: enough for compiler and CPU differences, tight
-# enough to catch a real regression.
+# Accuracy gates on the real optical-flow data: `roiflow eval` per dataset and preset, then the
+# mean EPE and AAE against their gates. Gates are the values measured when they were set (README,
+# "Accuracy") plus about 4 %: enough for compiler and CPU differences, tight enough to catch a
+# real regression. Strict: every row's figures must be finite numbers, the number of rows must
+# be the dataset's (a sequence silently dropped fails), and the mean row must be the mean of the
+# rows.
 #
-#   scripts/eval_gate.sh DIR [build-dir]
+#   scripts/eval_gate.sh DATA_ROOT [build-dir]      # e.g. ../shared/data
 set -euo pipefail
 cd "$(dirname "$0")/.."
-dir=$1
+source scripts/gate_lib.sh
+root=$1
 bin=${2:-build/release}/roiflow
-#        preset    max mean EPE  max mean AAE (measured: EPE / AAE)
-gates=("paper      0.88          7.40"   # 0.843 / 7.11
-       "accurate   0.465         5.60")  # 0.443 / 5.35
+#        folder      preset    pairs  max mean EPE  max mean AAE (measured: EPE / AAE)
+gates=("middlebury   paper     8      0.88          7.40"   # 0.843 / 7.11
+       "middlebury   accurate  8      0.465         5.60")  # 0.443 / 5.35
 status=0
 for gate in "${gates[@]}"; do
-  read -r preset max_epe max_aae <<<"$gate"
-  csv=$("$bin" eval "$dir" --preset "$preset" --format csv)
-  mean=$(tail -n 1 <<<"$csv")
-  IFS=, read -r name aae epe r1 r3 ms <<<"$mean"
-  if [[ "$name" != mean ]]; then
-    echo "gate: roiflow eval printed no mean row for preset $preset" >&2
-    exit 1
-  fi
+  read -r folder preset pairs max_epe max_aae <<<"$gate"
+  [[ -d "$root/$folder" ]] || gate_fail "$root/$folder not found"
+  csv=$("$bin" eval "$root/$folder" --preset "$preset" --format csv) ||
+    gate_fail "roiflow eval $root/$folder --preset $preset failed"
+  header=$(head -n 1 <<<"$csv")
+  [[ $header == sequence,aae_deg,epe,* ]] || gate_fail "unexpected header '$header'"
+  rows=$(tail -n +2 <<<"$csv" | grep -v '^mean,' || true)
+  gate_count "$folder/$preset rows" "$(grep -c . <<<"$rows" || true)" "$pairs"
+  sum_epe=0
+  sum_aae=0
+  while IFS=, read -r name aae epe _; do
+    gate_number "$folder/$preset $name AAE" "$aae"
+    gate_number "$folder/$preset $name EPE" "$epe"
+    sum_epe=$(awk -v s="$sum_epe" -v x="$epe" 'BEGIN { printf "%.6f", s + x }')
+    sum_aae=$(awk -v s="$sum_aae" -v x="$aae" 'BEGIN { printf "%.6f", s + x }')
+  done <<<"$rows"
+  mean=$(grep '^mean,' <<<"$csv" || true)
+  [[ $(grep -c . <<<"$mean" || true) == 1 ]] || gate_fail "$folder/$preset: no single mean row"
+  IFS=, read -r _ aae epe _ <<<"$mean"
+  gate_number "$folder/$preset mean AAE" "$aae"
+  gate_number "$folder/$preset mean EPE" "$epe"
+  # The printed mean must be the mean of the printed rows (to their rounding).
+  awk -v s="$sum_epe" -v n="$pairs" -v m="$epe" 'BEGIN { d = s / n - m; exit !(d < 1e-3 && d > -1e-3) }' ||
+    gate_fail "$folder/$preset: mean EPE $epe is not the mean of the $pairs rows"
   verdict=pass
-  if awk -v e="$epe" -v a="$aae" -v me="$max_epe" -v ma="$max_aae" \
-      'BEGIN { exit !(e > me || a > ma) }'; then
+  if ! gate_holds "$epe" '<=' "$max_epe" || ! gate_holds "$aae" '<=' "$max_aae"; then
     verdict=FAIL
     status=1
   fi
-  printf 'gate %-8s mean EPE %s (max %s)  mean AAE %s deg (max %s)  %s ms/pair  %s\n' \
-    "$preset" "$epe" "$max_epe" "$aae" "$max_aae" "$ms" "$verdict"
+  printf 'gate %-10s %-8s %d pairs  mean EPE %s (max %s)  mean AAE %s deg (max %s)  %s\n' \
+    "$folder" "$preset" "$pairs" "$epe" "$max_epe" "$aae" "$max_aae" "$verdict"
 done
 exit $status

@@ -347,7 +347,10 @@ TEST_F(CliVideoTest, TrackWritesLogSummaryAndVideoThatScoreReads) {
   EXPECT_EQ(summary.at("mode").get<std::string>(), "local");
   EXPECT_GT(summary.at("fps").get<double>(), 0.0);
   EXPECT_GT(summary.at("tracker_fps").get<double>(), 0.0);
-  EXPECT_GE(summary.at("global_activations").get<long long>(), 0);
+  // The scene's 10 px jump stays inside the local region: the target is never lost, so the
+  // global treatment never runs.
+  EXPECT_EQ(summary.at("global_activations").get<long long>(), 0);
+  EXPECT_EQ(summary.at("lost_frames").get<long long>(), 0);
   cv::VideoCapture video(path("annotated.avi"), cv::CAP_FFMPEG);
   ASSERT_TRUE(video.isOpened());
   EXPECT_EQ(static_cast<int>(video.get(cv::CAP_PROP_FRAME_COUNT)), 30);
@@ -356,7 +359,9 @@ TEST_F(CliVideoTest, TrackWritesLogSummaryAndVideoThatScoreReads) {
   ASSERT_EQ(s.exit_code, 0) << s.err;
   const auto score = nlohmann::json::parse(s.out);
   EXPECT_GT(score.at("precision20").get<double>(), 0.9);
-  EXPECT_GT(score.at("auc").get<double>(), 0.5);
+  // A perfect track scores 20/21 = 0.952 (OTB's strict threshold); measured 0.948, mean IoU 0.974.
+  EXPECT_GT(score.at("auc").get<double>(), 0.93);
+  EXPECT_GT(score.at("mean_iou").get<double>(), 0.95);
 }
 
 TEST_F(CliVideoTest, GlobalModeActivatesTheGlobalTreatmentEveryFrame) {

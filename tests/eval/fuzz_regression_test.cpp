@@ -34,7 +34,7 @@ const std::map<std::string, std::function<void(std::string_view)>>& checks() {
 }
 
 fs::path regressions_dir() {
-  return fs::path(__FILE__).parent_path().parent_path() / "fuzz_regressions";
+  return fs::path(ROIFLOW_FUZZ_REGRESSIONS_DIR);
 }
 
 class FuzzSeedCorpusTest : public test::TempDirTest {};
@@ -84,6 +84,9 @@ TEST(FuzzRegressionTest, EverySavedCrashInputIsHandled) {
     }
   }
   std::printf("replayed %d saved fuzz inputs\n", replayed);
+  // Three crash inputs are kept so far (two OTB ground-truth lines, one track-log line): a
+  // regressions folder that went missing or empty must fail, not pass having replayed nothing.
+  EXPECT_GE(replayed, 3);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -108,10 +109,15 @@ TEST(RunStats, FormatIsATableOfEveryStage) {
 TEST(RunStats, ScopedTimerAddsOneCall) {
   RunStats stats;
   { report::ScopedTimer timer(stats, "work"); }
-  { report::ScopedTimer timer(stats, "work"); }
+  {
+    report::ScopedTimer timer(stats, "work");
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
   const auto work = stats.to_json(1)["stages"]["work"];
   EXPECT_EQ(work["calls"], 2);
-  EXPECT_GE(work["ms_total"].get<double>(), 0.0);
+  // The sleep lasts at least 20 ms on the steady clock the timer reads; no upper bound (a loaded
+  // machine may sleep longer).
+  EXPECT_GE(work["ms_total"].get<double>(), 20.0);
 }
 
 TEST(RunStats, BadValuesThrowNamingThem) {

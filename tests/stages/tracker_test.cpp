@@ -105,11 +105,16 @@ TEST(Tracker, GlobalModeCountsOneActivationPerFrame) {
   EXPECT_GE(local.back().global_activations, 1);
   EXPECT_EQ(global.back().global_activations, 60);
   // The baseline is the same estimator: it tracks as well.
+  int found = 0;
   for (const TrackerOutput& o : global) {
     if (!o.lost) {
+      ++found;
       EXPECT_LT(center_error(o.box, scene.box(static_cast<int>(o.index))), 2.0);
     }
   }
+  // Measured: found in all 60 frames. A margin of two frames lets the jump be lost once and found
+  // on the next frame; a baseline that loses the object for good fails.
+  EXPECT_GE(found, 58);
 }
 
 TEST(Tracker, AJumpIsLostLocallyAndFoundAgainByAppearance) {

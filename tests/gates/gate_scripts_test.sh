@@ -1,0 +1,118 @@
+#!/usr/bin/env bash
+# The real-data gates fail when they should: a stub `roiflow` feeds them bad figures (an empty
+# or NaN mean row, a dropped sequence, a mean that is not the rows' mean, a truncated track log)
+# and each must make its gate exit non-zero; the same stub with good figures must pass, so a
+# failure is the bad row's doing. scripts/test.sh under CI=true without the data must fail.
+#
+#   tests/gates/gate_scripts_test.sh REPO_DIR ROIFLOW_BINARY
+set -uo pipefail
+repo=$1
+real_bin=$2
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+failures=0
+
+expect() {  # expect pass|fail DESCRIPTION COMMAND...
+  local want=$1 what=$2
+  shift 2
+  if "$@" >"$work/out.txt" 2>&1; then got=pass; else got=fail; fi
+  if [[ $got != "$want" ]]; then
+    echo "FAILED: $what: expected $want, got $got"
+    sed 's/^/  | /' "$work/out.txt"
+    failures=$((failures + 1))
+  else
+    echo "ok: $what ($got: $(tail -n 1 "$work/out.txt"))"
+  fi
+}
+
+# --- eval_gate.sh: a stub whose `eval` prints $work/eval.csv
+data="$work/data"
+mkdir -p "$data/middlebury" "$work/stub"
+cat >"$work/stub/roiflow" <<STUB
+#!/usr/bin/env bash
+if [[ \$1 == eval ]]; then cat "$work/eval.csv"; exit 0; fi
+if [[ \$1 == track ]]; then
+  while [[ \$# -gt 0 ]]; do
+    case \$1 in
+      --log) cp "$work/track.csv" "\$2"; shift ;;
+      --summary) echo '{"tracker_fps": 1000.0}' >"\$2"; shift ;;
+    esac
+    shift
+  done
+  exit 0
+fi
+exec "$real_bin" "\$@"
+STUB
+chmod +x "$work/stub/roiflow"
+
+eval_csv() {  # eval_csv ROWS MEAN_ROW [ROW_EPE]
+  {
+    echo "sequence,aae_deg,epe,r1,r3,ms"
+    for ((i = 0; i < $1; ++i)); do echo "seq$i,5.000,${3:-0.4000},1.0,1.0,10.0"; done
+    echo "$2"
+  } >"$work/eval.csv"
+}
+gate() { "$repo/scripts/eval_gate.sh" "$data" "$work/stub"; }
+eval_csv 8 "mean,5.000,0.4000,1.0,1.0,10.0"
+expect pass "eval gate, good figures" gate
+eval_csv 8 "mean,,,,,"
+expect fail "eval gate, empty mean row" gate
+eval_csv 8 "mean,nan,nan,nan,nan,nan"
+expect fail "eval gate, nan mean row" gate
+eval_csv 8 "mean,-nan,-nan,1.0,1.0,10.0"
+expect fail "eval gate, -nan mean row" gate
+eval_csv 7 "mean,5.000,0.4000,1.0,1.0,10.0"
+expect fail "eval gate, a sequence dropped" gate
+eval_csv 8 "mean,5.000,0.3000,1.0,1.0,10.0"
+expect fail "eval gate, mean not the rows' mean" gate
+eval_csv 8 "mean,5.000,0.9000,1.0,1.0,10.0" 0.9000
+expect fail "eval gate, EPE above its gate" gate
+{
+  echo "sequence,aae_deg,epe,r1,r3,ms"
+  for ((i = 0; i < 7; ++i)); do echo "seq$i,5.000,0.4000,1.0,1.0,10.0"; done
+  echo "seq7,inf,0.4000,1.0,1.0,10.0"
+  echo "mean,5.000,0.4000,1.0,1.0,10.0"
+} >"$work/eval.csv"
+expect fail "eval gate, inf in a row" gate
+rm -rf "$data/middlebury"
+eval_csv 8 "mean,5.000,0.4000,1.0,1.0,10.0"
+expect fail "eval gate, dataset folder missing" gate
+mkdir -p "$data/middlebury"
+
+# --- track_gate.sh: the stub writes $work/track.csv as the log; `score` is the real roiflow.
+seq="$work/seq"
+mkdir -p "$seq"
+: >"$seq/groundtruth_rect.txt"
+for ((i = 1; i <= 20; ++i)); do echo "10,20,30,40" >>"$seq/groundtruth_rect.txt"; done
+track_csv() {  # track_csv ROWS
+  echo "frame,x,y,w,h,vx,vy,mode,lost,ms" >"$work/track.csv"
+  for ((i = 1; i <= $1; ++i)); do echo "$i,10,20,30,40,0,0,local,0,0.1" >>"$work/track.csv"; done
+}
+tgate() { "$repo/scripts/track_gate.sh" "$seq" "$work/stub"; }
+track_csv 20
+expect pass "track gate, a full log" tgate
+track_csv 12
+expect fail "track gate, a truncated log" tgate
+sed -i '5s/.*/NaN,NaN,NaN,NaN/' "$seq/groundtruth_rect.txt"
+track_csv 20
+expect pass "track gate, an absent-target frame is not scored" tgate
+track_csv 19
+expect fail "track gate, one frame short with an absent-target frame" tgate
+
+# --- test.sh under CI without the data: a copy of scripts/ with no ../shared/data beside it,
+# and a build step that does nothing (the suite itself is not what is checked here).
+ci="$work/ci/repo"
+mkdir -p "$ci/scripts"
+cp "$repo"/scripts/*.sh "$ci/scripts/"
+printf '#!/usr/bin/env bash\nexit 0\n' >"$ci/scripts/build.sh"
+mkdir -p "$work/ci/bin"
+printf '#!/usr/bin/env bash\nexit 0\n' >"$work/ci/bin/ctest"
+chmod +x "$ci"/scripts/*.sh "$work/ci/bin/ctest"
+expect fail "test.sh, CI=true without ../shared/data" env PATH="$work/ci/bin:$PATH" CI=true "$ci/scripts/test.sh"
+expect pass "test.sh, no CI and no data: a warning" env PATH="$work/ci/bin:$PATH" CI= "$ci/scripts/test.sh"
+
+if ((failures > 0)); then
+  echo "$failures gate check(s) failed"
+  exit 1
+fi
+echo "all gate checks passed"
