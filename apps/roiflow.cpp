@@ -122,10 +122,9 @@ void run_flow(const FlowCommand& cmd) {
 
   const pipeline::TbbExecutor executor;
   flow::FlowOptions options;
-  options.executor = &executor;
   const auto start = std::chrono::steady_clock::now();
   const flow::FlowResult result = pipeline::run_with_threads(
-      cmd.lk.threads, [&] { return flow::dense_flow(frame0, frame1, params, options); });
+      cmd.lk.threads, [&] { return flow::dense_flow(frame0, frame1, params, options, &executor); });
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   // Scored before writing so that a failure here leaves no output behind.
@@ -186,7 +185,7 @@ struct EvalCommand {
   std::vector<std::vector<std::string>> pairs;  // A, B, ground truth
   std::vector<std::string> exclude_masks;
   std::string layout = "auto";
-  std::string pass = "clean";
+  std::string pass = "auto";
   std::string scene;
   int max_pairs = 0;
   std::string format = "table";
@@ -194,7 +193,9 @@ struct EvalCommand {
   std::string report;
 };
 
-std::vector<eval::EvalPair> eval_pairs(const EvalCommand& cmd) {
+// `skipped` receives what a partial tree lacks (see eval::find_pairs).
+std::vector<eval::EvalPair> eval_pairs(const EvalCommand& cmd,
+                                         std::vector<std::string>& skipped) {
   if (cmd.dir.empty() && cmd.pairs.empty()) {
     throw UsageError(
         "eval needs a Middlebury, Sintel or KITTI directory DIR or at least one --pair A B GT");
@@ -205,7 +206,7 @@ std::vector<eval::EvalPair> eval_pairs(const EvalCommand& cmd) {
     options.pass = cmd.pass;
     options.scene = cmd.scene;
     options.max_pairs = cmd.max_pairs;
-    return eval::find_pairs(cmd.dir, options);
+    return eval::find_pairs(cmd.dir, options, &skipped);
   }
   if (!cmd.exclude_masks.empty() && cmd.exclude_masks.size() != cmd.pairs.size()) {
     throw UsageError("--exclude-mask: got " + std::to_string(cmd.exclude_masks.size()) +
@@ -225,7 +226,11 @@ void run_eval(const EvalCommand& cmd) {
   const flow::LkParams params = lk_params(cmd.lk);
   if (!cmd.output.empty()) check_output_path(cmd.output, "-o");
   if (!cmd.report.empty()) check_output_path(cmd.report, "--report");
-  const std::vector<eval::EvalPair> pairs = eval_pairs(cmd);
+  std::vector<std::string> skipped;
+  const std::vector<eval::EvalPair> pairs = eval_pairs(cmd, skipped);
+  // Partial downloads are evaluated as they are, and the gaps said once, on stderr so that
+  // CSV and JSON on stdout stay machine-readable.
+  if (!skipped.empty()) std::cerr << "roiflow: " << eval::skipped_line(skipped) << "\n";
 
   std::optional<report::HtmlReport> report;
   if (!cmd.report.empty()) {
@@ -287,9 +292,11 @@ void add_eval_command(CLI::App& app, EvalCommand& cmd) {
       ->check(CLI::IsMember({"auto", "middlebury", "sintel", "kitti"}))
       ->capture_default_str()
       ->needs(dir);
-  sub->add_option("--pass", cmd.pass, "Sintel rendering pass")
+  sub->add_option("--pass", cmd.pass,
+                  "Sintel rendering pass (auto: per scene, the first of clean, final, albedo "
+                  "that the tree has; the pass shows in each row's name)")
       ->type_name("PASS")
-      ->check(CLI::IsMember({"clean", "final", "albedo"}))
+      ->check(CLI::IsMember({"auto", "clean", "final", "albedo"}))
       ->capture_default_str()
       ->needs(dir);
   sub->add_option("--scene", cmd.scene,

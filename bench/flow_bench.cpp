@@ -78,16 +78,11 @@ struct Method {
 FlowFn roiflow_flow(const roiflow::flow::LkParams& params) {
   // Stateless, and it runs in whichever arena run_with_threads set up: one serves every run.
   static const roiflow::pipeline::TbbExecutor executor;
-  roiflow::flow::FlowOptions options;
-  options.executor = &executor;
-  // Writes into the caller's flow buffer and reuses the confidence buffer, as DIS's calc()
-  // reuses its output: neither side pays for fresh pages on every call.
-  auto result = std::make_shared<roiflow::flow::FlowResult>();
-  return [params, options, result](const Scene& s, cv::Mat& flow) {
-    result->flow = flow;
-    roiflow::flow::dense_flow(s.frame0, s.frame1, params, *result, options);
-    flow = result->flow;
-  };
+  // The OpenCV interface, as a DIS user would swap it in: one object keeps its workspace and
+  // writes into the caller's flow buffer, as DIS's calc() does, so neither side pays for fresh
+  // pages on every call.
+  cv::Ptr<cv::DenseOpticalFlow> lk = roiflow::flow::createDenseLK(params, &executor);
+  return [lk](const Scene& s, cv::Mat& flow) { lk->calc(s.frame0, s.frame1, flow); };
 }
 
 FlowFn dis_flow(int preset) {

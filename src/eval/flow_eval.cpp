@@ -55,7 +55,8 @@ fs::path benchmark_root(const std::string& dir, const char* marker) {
 }
 
 bool is_sintel_root(const fs::path& root) {
-  return is_dir(root / "flow") && (is_dir(root / "clean") || is_dir(root / "final"));
+  return is_dir(root / "flow") &&
+         (is_dir(root / "clean") || is_dir(root / "final") || is_dir(root / "albedo"));
 }
 
 bool is_kitti_root(const fs::path& root) {
@@ -86,14 +87,8 @@ std::string sintel_frame_name(int number) {
   return name;
 }
 
-void require_file(const std::string& layout, const std::string& pair, const fs::path& path) {
-  if (!is_file(path)) {
-    throw Error(layout + " pair '" + pair + "': missing file '" + path.string() + "'");
-  }
-}
-
 std::string scene_of(const EvalPair& pair) {
-  return pair.name.substr(0, pair.name.find('/'));
+  return pair.name.substr(0, pair.name.find_first_of("/ "));
 }
 
 bool has_extension(const std::string& path, const std::string& extension) {
@@ -228,47 +223,125 @@ std::vector<EvalPair> find_middlebury(const std::string& dir) {
   return pairs;
 }
 
-std::vector<EvalPair> find_sintel(const std::string& dir, const std::string& pass) {
+namespace {
+
+// Where find_* put what they left out: a list when the caller accepts partial trees, else
+// nothing (the first gap is an error, as it always was).
+class Gaps {
+ public:
+  explicit Gaps(std::vector<std::string>* skipped) : skipped_(skipped) {}
+  // `what` is left out because of `why`; throws `context` + `why` when partial trees are not
+  // accepted.
+  void skip(const std::string& what, const std::string& context, const std::string& why) const {
+    if (!skipped_) throw Error(context + why);
+    skipped_->push_back(what + " (" + why + ")");
+  }
+  bool partial() const { return skipped_ != nullptr; }
+
+ private:
+  std::vector<std::string>* skipped_;
+};
+
+bool valid_pass_name(const std::string& pass) {
+  return !pass.empty() && pass.find_first_of("/\\") == std::string::npos && pass != "." &&
+         pass != "..";
+}
+
+// The pass a Sintel scene is read from: `pass` itself, or for "auto" the first of clean,
+// final, albedo that has the scene's folder. Empty when the scene has none.
+std::string scene_pass(const fs::path& root, const std::string& scene, const std::string& pass) {
+  if (pass != "auto") return is_dir(root / pass / scene) ? pass : std::string();
+  for (const char* candidate : {"clean", "final", "albedo"}) {
+    if (is_dir(root / candidate / scene)) return candidate;
+  }
+  return {};
+}
+
+// The pairs of one Sintel scene read from `pass`; gaps are skipped or thrown through `gaps`.
+void sintel_scene_pairs(const fs::path& root, const fs::path& scene_dir, const std::string& pass,
+                        const Gaps& gaps, std::vector<EvalPair>& pairs) {
+  const std::string scene = scene_dir.filename().string();
+  const fs::path occlusions = root / "occlusions" / scene;
+  const fs::path invalid = root / "invalid" / scene;
+  for (const fs::path& flo : sorted_entries(scene_dir)) {
+    const int number = sintel_frame_number(flo.filename().string());
+    if (number < 0 || !is_file(flo)) continue;
+    const std::string frame = sintel_frame_name(number);
+    const std::string name = scene + "/" + frame;
+    EvalPair pair;
+    // The pass is part of the name: rows of one tree may come from different passes.
+    pair.name = name + " (" + pass + ")";
+    pair.frame0 = (root / pass / scene / (frame + ".png")).string();
+    pair.frame1 = (root / pass / scene / (sintel_frame_name(number + 1) + ".png")).string();
+    pair.ground_truth = flo.string();
+    const std::string context = "Sintel pair '" + name + "': ";
+    bool complete = true;
+    for (const std::string* file : {&pair.frame0, &pair.frame1}) {
+      if (complete && !is_file(*file)) {
+        gaps.skip("Sintel pair " + name, context, "missing file '" + *file + "'");
+        complete = false;
+      }
+    }
+    if (complete && is_dir(invalid)) {
+      // Without its invalid mask a pair would score pixels that have no true flow.
+      pair.exclude_mask = (invalid / (frame + ".png")).string();
+      if (!is_file(pair.exclude_mask)) {
+        gaps.skip("Sintel pair " + name, context, "missing file '" + pair.exclude_mask + "'");
+        complete = false;
+      }
+    }
+    if (!complete) continue;
+    if (is_dir(occlusions)) {
+      const std::string mask = (occlusions / (frame + ".png")).string();
+      if (is_file(mask)) {
+        pair.occlusion_mask = mask;
+      } else {
+        gaps.skip("the non-occluded figures of Sintel pair " + name, context,
+                  "missing file '" + mask + "'");
+      }
+    }
+    pairs.push_back(std::move(pair));
+  }
+}
+
+}  // namespace
+
+std::vector<EvalPair> find_sintel(const std::string& dir, const std::string& pass,
+                                  std::vector<std::string>* skipped) {
   check_dir(dir, "Sintel");
   const fs::path root = benchmark_root(dir, "flow");
   if (!is_dir(root / "flow")) {
     throw Error("no Sintel tree in '" + dir + "' (expected flow/<scene>/frame_NNNN.flo)");
   }
-  if (pass.empty() || pass.find_first_of("/\\") != std::string::npos || pass == "." ||
-      pass == "..") {
-    throw Error("Sintel pass must be a folder name such as clean or final, got '" + pass + "'");
+  if (!valid_pass_name(pass)) {
+    throw Error("Sintel pass must be auto or a folder name such as clean or final, got '" + pass +
+                "'");
   }
-  if (!is_dir(root / pass)) {
+  if (pass != "auto" && !is_dir(root / pass)) {
     throw Error("Sintel tree '" + root.string() + "' has no '" + pass + "' pass (no folder '" +
                 (root / pass).string() + "')");
   }
+  const Gaps gaps(skipped);
   std::vector<EvalPair> pairs;
   for (const fs::path& scene_dir : sorted_entries(root / "flow")) {
     if (!is_dir(scene_dir)) continue;
     const std::string scene = scene_dir.filename().string();
-    const fs::path occlusions = root / "occlusions" / scene;
-    const fs::path invalid = root / "invalid" / scene;
-    for (const fs::path& flo : sorted_entries(scene_dir)) {
-      const int number = sintel_frame_number(flo.filename().string());
-      if (number < 0 || !is_file(flo)) continue;
-      const std::string frame = sintel_frame_name(number);
-      EvalPair pair;
-      pair.name = scene + "/" + frame;
-      pair.frame0 = (root / pass / scene / (frame + ".png")).string();
-      pair.frame1 = (root / pass / scene / (sintel_frame_name(number + 1) + ".png")).string();
-      pair.ground_truth = flo.string();
-      require_file("Sintel", pair.name, pair.frame0);
-      require_file("Sintel", pair.name, pair.frame1);
-      if (is_dir(occlusions)) {
-        pair.occlusion_mask = (occlusions / (frame + ".png")).string();
-        require_file("Sintel", pair.name, pair.occlusion_mask);
+    const std::string chosen = scene_pass(root, scene, pass);
+    if (chosen.empty()) {
+      // Strict: the first missing frame names the file, as it always did.
+      if (!gaps.partial()) {
+        sintel_scene_pairs(root, scene_dir, pass == "auto" ? "clean" : pass, gaps, pairs);
+        continue;
       }
-      if (is_dir(invalid)) {
-        pair.exclude_mask = (invalid / (frame + ".png")).string();
-        require_file("Sintel", pair.name, pair.exclude_mask);
-      }
-      pairs.push_back(std::move(pair));
+      gaps.skip("Sintel scene " + scene, "",
+                pass == "auto" ? "no clean/, final/ or albedo/ folder of the scene"
+                               : "no " + pass + "/" + scene + "/ folder");
+      continue;
     }
+    sintel_scene_pairs(root, scene_dir, chosen, gaps, pairs);
+  }
+  if (pairs.empty() && skipped && !skipped->empty()) {
+    throw Error("no Sintel pair to evaluate in '" + dir + "': " + skipped_line(*skipped));
   }
   if (pairs.empty()) {
     throw Error("no Sintel pair in '" + dir + "' (expected flow/<scene>/frame_NNNN.flo)");
@@ -276,7 +349,7 @@ std::vector<EvalPair> find_sintel(const std::string& dir, const std::string& pas
   return pairs;
 }
 
-std::vector<EvalPair> find_kitti(const std::string& dir) {
+std::vector<EvalPair> find_kitti(const std::string& dir, std::vector<std::string>* skipped) {
   check_dir(dir, "KITTI");
   const fs::path root = benchmark_root(dir, "flow_occ");
   if (!is_dir(root / "flow_occ")) {
@@ -288,34 +361,67 @@ std::vector<EvalPair> find_kitti(const std::string& dir) {
     throw Error("KITTI tree '" + root.string() +
                 "' has flow_occ/ but neither image_0/ nor image_2/");
   }
+  const Gaps gaps(skipped);
   const fs::path noc = root / "flow_noc";
   const std::string suffix = "_10.png";
+  const auto is_truth = [&](const fs::path& file) {
+    const std::string filename = file.filename().string();
+    return filename.size() > suffix.size() &&
+           filename.compare(filename.size() - suffix.size(), suffix.size(), suffix) == 0 &&
+           is_file(file);
+  };
   std::vector<EvalPair> pairs;
   for (const fs::path& truth : sorted_entries(root / "flow_occ")) {
+    if (!is_truth(truth)) continue;
     const std::string filename = truth.filename().string();
-    if (filename.size() <= suffix.size() ||
-        filename.compare(filename.size() - suffix.size(), suffix.size(), suffix) != 0 ||
-        !is_file(truth)) {
-      continue;
-    }
     const std::string id = filename.substr(0, filename.size() - suffix.size());
     EvalPair pair;
     pair.name = id;
     pair.frame0 = (images / (id + "_10.png")).string();
     pair.frame1 = (images / (id + "_11.png")).string();
     pair.ground_truth = truth.string();
-    require_file("KITTI", id, pair.frame0);
-    require_file("KITTI", id, pair.frame1);
+    const std::string context = "KITTI pair '" + id + "': ";
+    if (!is_file(pair.frame0) || !is_file(pair.frame1)) {
+      gaps.skip("KITTI pair " + id, context,
+                "missing file '" + (is_file(pair.frame0) ? pair.frame1 : pair.frame0) + "'");
+      continue;
+    }
     if (is_dir(noc)) {
-      pair.noc_ground_truth = (noc / filename).string();
-      require_file("KITTI", id, pair.noc_ground_truth);
+      const std::string noc_truth = (noc / filename).string();
+      if (is_file(noc_truth)) {
+        pair.noc_ground_truth = noc_truth;
+      } else {
+        gaps.skip("the non-occluded figures of KITTI pair " + id, context,
+                  "missing file '" + noc_truth + "'");
+      }
     }
     pairs.push_back(std::move(pair));
+  }
+  if (is_dir(noc) && gaps.partial()) {
+    // Pairs with only the non-occluded truth are not scored as if it were all of it.
+    for (const fs::path& truth : sorted_entries(noc)) {
+      if (is_truth(truth) && !is_file(root / "flow_occ" / truth.filename())) {
+        const std::string name = truth.filename().string();
+        gaps.skip("KITTI pair " + name.substr(0, name.size() - suffix.size()), "",
+                  "flow_noc/" + name + " without flow_occ/" + name);
+      }
+    }
+  }
+  if (pairs.empty() && skipped && !skipped->empty()) {
+    throw Error("no KITTI pair to evaluate in '" + dir + "': " + skipped_line(*skipped));
   }
   if (pairs.empty()) {
     throw Error("no KITTI pair in '" + dir + "' (expected flow_occ/NNNNNN_10.png)");
   }
   return pairs;
+}
+
+std::string skipped_line(const std::vector<std::string>& skipped) {
+  if (skipped.empty()) return {};
+  std::string line = "skipped " + std::to_string(skipped.size()) + ": ";
+  for (std::size_t i = 0; i < skipped.size(); ++i)
+    line += (i ? "; " : "") + skipped[i];
+  return line;
 }
 
 Layout detect_layout(const std::string& dir) {
@@ -330,7 +436,8 @@ Layout detect_layout(const std::string& dir) {
               "or flow/ with clean/ or final/, or image_0/ or image_2/ with flow_occ/)");
 }
 
-std::vector<EvalPair> find_pairs(const std::string& dir, const FindOptions& options) {
+std::vector<EvalPair> find_pairs(const std::string& dir, const FindOptions& options,
+                                 std::vector<std::string>* skipped) {
   if (options.max_pairs < 0) {
     throw Error("max pairs must be >= 0 (0 = all), got " + std::to_string(options.max_pairs));
   }
@@ -338,10 +445,10 @@ std::vector<EvalPair> find_pairs(const std::string& dir, const FindOptions& opti
   std::vector<EvalPair> pairs;
   switch (layout) {
     case Layout::Sintel:
-      pairs = find_sintel(dir, options.pass);
+      pairs = find_sintel(dir, options.pass, skipped);
       break;
     case Layout::Kitti:
-      pairs = find_kitti(dir);
+      pairs = find_kitti(dir, skipped);
       break;
     case Layout::Auto:
     case Layout::Middlebury:
@@ -405,9 +512,8 @@ EvalRow evaluate_pair(const EvalPair& pair, const flow::LkParams& params, const 
   }
 
   flow::FlowOptions options;
-  options.executor = executor;
   const auto start = std::chrono::steady_clock::now();
-  const flow::FlowResult result = flow::dense_flow(frame0, frame1, params, options);
+  const flow::FlowResult result = flow::dense_flow(frame0, frame1, params, options, executor);
   const auto stop = std::chrono::steady_clock::now();
 
   EvalRow row;

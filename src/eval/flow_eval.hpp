@@ -63,9 +63,11 @@ Layout parse_layout(const std::string& name);
 
 struct FindOptions {
   Layout layout = Layout::Auto;
-  std::string pass = "clean";  // Sintel rendering pass: a folder next to flow/ (clean, final)
-  std::string scene;           // keep only this scene ("alley_1", "Venus", "000042"); "" = all
-  int max_pairs = 0;           // > 0: at most this many pairs, evenly spaced over the sorted list
+  // Sintel rendering pass: a folder next to flow/ (clean, final), or "auto": per scene, the
+  // first of clean, final, albedo that the tree has.
+  std::string pass = "auto";
+  std::string scene;  // keep only this scene ("alley_1", "Venus", "000042"); "" = all
+  int max_pairs = 0;  // > 0: at most this many pairs, evenly spaced over the sorted list
 };
 
 // Reads an image file as 8-bit gray (colour is converted). Throws roiflow::Error naming the
@@ -79,19 +81,33 @@ cv::Mat read_flow_ground_truth(const std::string& path);
 // Throws roiflow::Error when DIR is missing, not a directory, or holds no such sequence.
 std::vector<EvalPair> find_middlebury(const std::string& dir);
 
+// Partial trees. The finders below take `skipped`: when it is null a tree must be complete
+// (every gap throws roiflow::Error naming the missing file); when it is given, what is there is
+// evaluated and every part left out is appended to it as "what (why)", e.g.
+// "the non-occluded figures of KITTI pair 000000 (... missing file '.../flow_noc/000000_10.png')".
+// A tree where nothing is left to evaluate throws either way. skipped_line() makes the one line
+// a caller prints about them ("" when nothing was skipped).
+
 // MPI-Sintel: DIR (or DIR/training) holds flow/<scene>/frame_NNNN.flo and
 // <pass>/<scene>/frame_NNNN.png; each .flo is the pair (NNNN, NNNN+1). When
 // occlusions/<scene>/ and invalid/<scene>/ exist, frame_NNNN.png there is the pair's occlusion
-// mask and exclude mask. Sorted by scene, then frame. Throws roiflow::Error when the pass folder
-// is missing, a frame or mask of a pair is missing, or there is no pair at all.
-std::vector<EvalPair> find_sintel(const std::string& dir, const std::string& pass = "clean");
+// mask and exclude mask. `pass` "auto" reads each scene from the first of clean/, final/,
+// albedo/ that has it (partial downloads ship one pass per scene); the pass read is part of
+// each pair's name: "alley_1/frame_0001 (clean)". Sorted by scene, then frame. Throws
+// roiflow::Error when a named pass folder is missing or there is no pair at all; partial: a
+// scene without the pass and a pair without a frame or invalid mask are skipped, a pair without
+// its occlusion mask loses its non-occluded figures.
+std::vector<EvalPair> find_sintel(const std::string& dir, const std::string& pass = "auto",
+                                  std::vector<std::string>* skipped = nullptr);
 
 // KITTI 2012 (image_0/) or 2015 (image_2/): DIR (or DIR/training) holds
 // image_N/NNNNNN_10.png, NNNNNN_11.png and flow_occ/NNNNNN_10.png (all pixels); when flow_noc/
 // exists, flow_noc/NNNNNN_10.png is the non-occluded ground truth. Sorted by name. Throws
-// roiflow::Error when flow_occ/ is missing, a frame or flow_noc file of a pair is missing, or
-// there is no pair at all.
-std::vector<EvalPair> find_kitti(const std::string& dir);
+// roiflow::Error when flow_occ/ is missing or there is no pair at all; partial: a pair without a
+// frame is skipped, a pair without its flow_noc file loses its non-occluded figures, and a
+// flow_noc file without flow_occ is reported, not scored.
+std::vector<EvalPair> find_kitti(const std::string& dir,
+                                 std::vector<std::string>* skipped = nullptr);
 
 // Which layout DIR holds: Sintel (flow/ with clean/ or final/), KITTI (image_0/ or image_2/
 // with flow_occ/ or flow_noc/), each possibly under DIR/training, else Middlebury (a
@@ -99,8 +115,13 @@ std::vector<EvalPair> find_kitti(const std::string& dir);
 Layout detect_layout(const std::string& dir);
 
 // The pairs of DIR in options.layout (Auto: detect_layout), filtered by scene, then thinned to
-// max_pairs. Throws roiflow::Error for an unknown scene or a negative max_pairs.
-std::vector<EvalPair> find_pairs(const std::string& dir, const FindOptions& options = {});
+// max_pairs; `skipped` as above. Throws roiflow::Error for an unknown scene or a negative
+// max_pairs.
+std::vector<EvalPair> find_pairs(const std::string& dir, const FindOptions& options = {},
+                                 std::vector<std::string>* skipped = nullptr);
+
+// "skipped N: a (why); b (why)", or "" when `skipped` is empty.
+std::string skipped_line(const std::vector<std::string>& skipped);
 
 // `executor` runs dense_flow's row stripes; nullptr = serial. `images`, when given, receives
 // the frames, ground truth, estimate and scored mask.

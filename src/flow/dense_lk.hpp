@@ -1,8 +1,10 @@
 // Dense iterative pyramidal Lucas–Kanade optical flow (the paper's Algorithm 1).
 //
 //   using namespace roiflow::flow;
-//   FlowResult r = dense_flow(frame_t, frame_t1, LkParams::paper());
-//   cv::Mat flow = r.flow;            // CV_32FC2: (u, v) in pixels, u right, v down, t -> t+1
+//   DenseLK lk(LkParams::paper());           // owns its buffers; reuse it for every pair
+//   FlowResult r = lk.calc(frame_t, frame_t1);
+//   cv::Mat flow = r.flow;                   // CV_32FC2: (u, v) in pixels, u right, v down
+//   cv::Ptr<cv::DenseOpticalFlow> of = createDenseLK();   // drop-in for cv::DISOpticalFlow
 //
 // For each pyramid level from coarse to fine: the flow of the coarser level is upsampled x2
 // (bilinear), frame t+1 is warped towards frame t with sub-pixel bilinear interpolation, and
@@ -19,7 +21,10 @@
 // is 11 taps with half-weight ends: no half-pixel shift in either case.
 #pragma once
 
+#include <cstddef>
+#include <memory>
 #include <opencv2/core.hpp>
+#include <opencv2/video/tracking.hpp>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -69,8 +74,10 @@ struct FlowOptions {
   cv::Rect region;
   // Motion assumed before the coarsest level (e.g. a tracker's prediction), in pixels.
   cv::Point2f initial_motion{0.f, 0.f};
-  // Runs row stripes; nullptr = serial.
-  const Executor* executor = nullptr;
+  // A flow field to start the coarsest level from, instead of `initial_motion` (e.g. a coarse
+  // search for motions larger than the patch): CV_32FC2, (u, v) in pixels of that level, the
+  // size of the whole level, level_size(frame size, flow_pyramid_levels(...) - 1). Empty = off.
+  cv::Mat initial_flow;
   // Pixels of context computed around the region at every level. -1: as many as the
   // iterations read (iterations x window reach), which is what makes the region's flow equal the
   // whole frame's; that context dominates the cost of a small region (a 50x37 region costs as
@@ -97,21 +104,71 @@ struct FlowResult {
   cv::Rect region;     // where in frame t the result lies
 };
 
-// Flow from frame t to frame t+1. Both images: same size, types accepted by build_pyramid.
+// Dense flow with its own workspace (pyramids, flow planes, row buffers: ~10 MB at 640x480),
+// kept across calls so that a video loop allocates nothing per pair, and freed with the object
+// or by collectGarbage(). One object computes one pair at a time; give each thread its own.
+// The executor runs the row stripes (nullptr = serial); the result is bit-identical for any
+// executor and thread count.
+class DenseLK {
+ public:
+  // Throws roiflow::Error naming the first parameter out of range.
+  explicit DenseLK(const LkParams& params = LkParams::paper(), const Executor* executor = nullptr);
+  ~DenseLK();
+  DenseLK(DenseLK&&) noexcept;
+  DenseLK& operator=(DenseLK&&) noexcept;
+  DenseLK(const DenseLK&) = delete;
+  DenseLK& operator=(const DenseLK&) = delete;
+
+  // Flow from frame t to frame t+1. Both images: same size, types accepted by build_pyramid.
+  // Writes into `result`, reusing its buffers when sizes match (as OpenCV's output arrays do):
+  // clone() what must outlive the next call.
+  void calc(const cv::Mat& frame_t, const cv::Mat& frame_t1, FlowResult& result,
+            const FlowOptions& options = {});
+  // The same on pyramids built once per frame (a video frame serves two pairs). The pyramids
+  // must have the same size and at least flow_pyramid_levels(size, params, options) levels.
+  void calc(const Pyramid& pyr_t, const Pyramid& pyr_t1, FlowResult& result,
+            const FlowOptions& options = {});
+  FlowResult calc(const cv::Mat& frame_t, const cv::Mat& frame_t1, const FlowOptions& options = {});
+  FlowResult calc(const Pyramid& pyr_t, const Pyramid& pyr_t1, const FlowOptions& options = {});
+
+  const LkParams& params() const { return params_; }
+  void set_params(const LkParams& params);  // validates, as the constructor
+  const Executor* executor() const { return executor_; }
+  void set_executor(const Executor* executor) { executor_ = executor; }
+
+  // Frees the workspace now (the next calc allocates it again), as
+  // cv::DenseOpticalFlow::collectGarbage does.
+  void collectGarbage();
+  // Bytes the workspace holds now.
+  std::size_t workspace_bytes() const;
+
+  struct Workspace;
+
+ private:
+  LkParams params_;
+  const Executor* executor_ = nullptr;
+  std::unique_ptr<Workspace> ws_;
+};
+
+// An OpenCV dense optical flow object computing DenseLK with `params`: swap
+// cv::DISOpticalFlow::create(...) for createDenseLK(...) and keep calling calc(I0, I1, flow).
+// calc takes 8-bit gray or BGR (and the other types build_pyramid accepts), writes CV_32FC2 into
+// `flow` (its input value is not used) and gives dense_flow's result bit for bit.
+cv::Ptr<cv::DenseOpticalFlow> createDenseLK(const LkParams& params = LkParams::paper(),
+                                            const Executor* executor = nullptr);
+
+// Conveniences: a DenseLK for one call (its workspace is allocated and freed every time; a loop
+// over a video should keep a DenseLK instead).
 FlowResult dense_flow(const cv::Mat& frame_t, const cv::Mat& frame_t1, const LkParams& params,
-                      const FlowOptions& options = {});
-
-// Same on pyramids built once per frame (a video frame serves two pairs). The pyramids must
-// have the same size and at least flow_pyramid_levels(size, params, options) levels.
+                      const FlowOptions& options = {}, const Executor* executor = nullptr);
 FlowResult dense_flow(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkParams& params,
-                      const FlowOptions& options = {});
-
-// The same into `result`, reusing its buffers when sizes match (as OpenCV's output arrays do):
-// a video loop then allocates nothing per frame. clone() what must outlive the next call.
+                      const FlowOptions& options = {}, const Executor* executor = nullptr);
 void dense_flow(const cv::Mat& frame_t, const cv::Mat& frame_t1, const LkParams& params,
-                FlowResult& result, const FlowOptions& options = {});
+                FlowResult& result, const FlowOptions& options = {},
+                const Executor* executor = nullptr);
 void dense_flow(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkParams& params,
-                FlowResult& result, const FlowOptions& options = {});
+                FlowResult& result, const FlowOptions& options = {},
+                const Executor* executor = nullptr);
 
 // How many levels the pyramids given to dense_flow need for `options` at frame size `size`:
 // effective_levels(size, max(levels, finest_level + min(levels, 2))), at most kMaxLevels.

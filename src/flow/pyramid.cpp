@@ -153,16 +153,45 @@ void base_level(const cv::Mat& image, double sigma, cv::Mat& out) {
 
 }  // namespace
 
-void build_pyramid(const cv::Mat& image, int levels, double sigma, Pyramid& out) {
+void build_base_level(const cv::Mat& image, int levels, double sigma, Pyramid& out) {
   if (image.empty()) throw Error("image is empty");
   if (!(sigma >= 0.0 && sigma <= 20.0)) {
     throw Error("smoothing sigma must be in [0, 20], got " + std::to_string(sigma));
   }
-  const int n = effective_levels(image.size(), levels);
-  out.levels.resize(n);
+  out.levels.resize(effective_levels(image.size(), levels));
   base_level(image, sigma, out.levels[0]);
-  for (int l = 1; l < n; ++l)
-    cv::pyrDown(out.levels[l - 1], out.levels[l]);
+}
+
+void build_level(Pyramid& pyr, int level) {
+  if (level < 1 || level >= pyr.num_levels()) {
+    throw Error("pyramid level " + std::to_string(level) + " is outside 1.." +
+                std::to_string(pyr.num_levels() - 1));
+  }
+  cv::pyrDown(pyr.levels[level - 1], pyr.levels[level]);
+}
+
+void build_pyramid(const cv::Mat& image, int levels, double sigma, Pyramid& out) {
+  build_base_level(image, levels, sigma, out);
+  for (int l = 1; l < out.num_levels(); ++l)
+    build_level(out, l);
+}
+
+void build_pyramid_part(const cv::Mat& image, const cv::Rect& rect, int levels, double sigma,
+                        Pyramid& out) {
+  const int grid = 1 << (std::clamp(levels, 1, kMaxLevels) - 1);
+  if (rect.empty() || (rect & cv::Rect(cv::Point(), image.size())) != rect || rect.x % grid != 0 ||
+      rect.y % grid != 0) {
+    throw Error("pyramid part (" + std::to_string(rect.x) + ", " + std::to_string(rect.y) + ") " +
+                std::to_string(rect.width) + "x" + std::to_string(rect.height) +
+                " must lie in the " + std::to_string(image.cols) + "x" +
+                std::to_string(image.rows) + " image with its origin on a multiple of " +
+                std::to_string(grid));
+  }
+  build_pyramid(image(rect), levels, sigma, out);
+}
+
+cv::Rect part_level_rect(const cv::Rect& rect, int level) {
+  return {cv::Point(rect.x >> level, rect.y >> level), level_size(rect.size(), level)};
 }
 
 Pyramid build_pyramid(const cv::Mat& image, int levels, double sigma) {

@@ -1,13 +1,15 @@
-// Gaussian image pyramid, the pretreatment and the multi-scale support of dense LK.
+// Gaussian image pyramid, the pretreatment and the multi-scale support of dense LK: the one
+// builder of every pyramid in roiflow (whole frames, parts of frames, level by level).
 //
 //   auto pyr = roiflow::flow::build_pyramid(gray8, /*levels=*/3, /*sigma=*/1.0);
 //   const cv::Mat& coarsest = pyr.levels.back();    // CV_32FC1, intensities in [0, 1]
 //
 // Level 0 is the input converted to float in [0, 1] and smoothed by a Gaussian of `sigma`
-// pixels (0 = no smoothing, the paper's pretreatment otherwise). Level k+1 is cv::pyrDown of
-// level k (5-tap Gaussian, factor 2, size (w+1)/2 x (h+1)/2, so pixel x of level k+1 sits at
-// 2x of level k). An image too small for the levels asked gets fewer levels: the coarsest
-// level keeps at least `kMinLevelSide` pixels on its shorter side.
+// pixels (0 = no smoothing, the paper's pretreatment otherwise). Level k+1 is level k
+// smoothed by the 5-tap Gaussian [1 4 6 4 1]/16 and decimated by 2 (cv::pyrDown's values,
+// size (w+1)/2 x (h+1)/2, so pixel x of level k+1 sits at 2x of level k). An image too small
+// for the levels asked gets fewer levels: the coarsest level keeps at least `kMinLevelSide`
+// pixels on its shorter side.
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -38,5 +40,21 @@ Pyramid build_pyramid(const cv::Mat& image, int levels, double sigma);
 // The same into `out`, reusing its buffers when the sizes match (one pyramid per video frame
 // without an allocation per frame). `out` must not share buffers with `image`.
 void build_pyramid(const cv::Mat& image, int levels, double sigma, Pyramid& out);
+
+// Level by level (a graph with one node per level): build_base_level writes level 0 and sizes
+// out.levels for effective_levels(image.size(), levels), keeping the coarser levels' buffers;
+// build_level(out, l) then makes level l from level l - 1. Together they equal build_pyramid.
+void build_base_level(const cv::Mat& image, int levels, double sigma, Pyramid& out);
+void build_level(Pyramid& pyr, int level);
+
+// The pyramid of part `rect` of `image` (build_pyramid of image(rect)). rect.tl() must lie on
+// the grid of the coarsest level (multiples of 2^(levels - 1)), so that level l is the frame's
+// level l over part_level_rect(rect, l), except near the part's edges where the smoothing sees
+// a replicated border instead of the frame. Throws roiflow::Error otherwise.
+void build_pyramid_part(const cv::Mat& image, const cv::Rect& rect, int levels, double sigma,
+                        Pyramid& out);
+// Level l of a part whose level 0 is `rect` (origin on the grid of level l): rect / 2^l, with
+// the sizes the pyramid gives it.
+cv::Rect part_level_rect(const cv::Rect& rect, int level);
 
 }  // namespace roiflow::flow

@@ -4,11 +4,13 @@
 #include <oneapi/tbb/info.h>
 
 #include <chrono>
+#include <memory>
 #include <mutex>
 #include <opencv2/imgproc.hpp>
 #include <string>
 #include <tuple>
 #include <unordered_map>
+#include <vector>
 
 #include "core/error.hpp"
 #include "pipeline/tbb_executor.hpp"
@@ -146,15 +148,32 @@ class PyramidPool : public std::enable_shared_from_this<PyramidPool> {
   std::vector<std::unique_ptr<flow::Pyramid>> free_;
 };
 
-// Level 0 of `pyr` from `gray`, keeping the buffers of the coarser levels for pyrDown to reuse.
-void build_base_level(const cv::Mat& gray, double sigma, int levels, flow::Pyramid& pyr) {
-  std::vector<cv::Mat> coarser;
-  if (pyr.levels.size() > 1) coarser.assign(pyr.levels.begin() + 1, pyr.levels.end());
-  flow::build_pyramid(gray, 1, sigma, pyr);
-  pyr.levels.resize(static_cast<std::size_t>(flow::effective_levels(gray.size(), levels)));
-  for (std::size_t i = 1; i < pyr.levels.size() && i - 1 < coarser.size(); ++i)
-    pyr.levels[i] = coarser[i - 1];
-}
+// DenseLK objects for the flow nodes of one run: a pair borrows one (its workspace stays warm:
+// allocating ~10 MB per pair costs page faults) and gives it back. A free list, not one per
+// thread: a thread that waits inside OpenCV's TBB loops may start another pair meanwhile.
+class DenseLkPool {
+ public:
+  explicit DenseLkPool(const flow::LkParams& params) : params_(params) {}
+  void calc(const flow::Pyramid& t, const flow::Pyramid& t1, flow::FlowResult& result) {
+    std::unique_ptr<flow::DenseLK> lk;
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      if (!free_.empty()) {
+        lk = std::move(free_.back());
+        free_.pop_back();
+      }
+    }
+    if (!lk) lk = std::make_unique<flow::DenseLK>(params_);
+    lk->calc(t, t1, result);
+    const std::lock_guard<std::mutex> lock(mutex_);
+    free_.push_back(std::move(lk));
+  }
+
+ private:
+  flow::LkParams params_;
+  std::mutex mutex_;
+  std::vector<std::unique_ptr<flow::DenseLK>> free_;
+};
 
 // source -> limiter -> level 0 -> level 1 -> ... -> sequencer: the part both modes share.
 class FrontEnd {
@@ -181,9 +200,9 @@ class FrontEnd {
         const auto start = Clock::now();
         flow::Pyramid& pyr = *m.pyramid;
         if (level == 0) {
-          build_base_level(m.frame->gray, sigma, levels, pyr);
+          flow::build_base_level(m.frame->gray, levels, sigma, pyr);
         } else if (level < pyr.num_levels()) {
-          cv::pyrDown(pyr.levels[level - 1], pyr.levels[level]);
+          flow::build_level(pyr, level);
         }
         run_.time("pyramid", start);
         return m;
@@ -397,6 +416,7 @@ RunReport run_dense(const FrameSource& source, const flow::LkParams& params,
       previous = m;
     });
 
+    DenseLkPool lk_pool(params);
     tf::function_node<PairJob, FlowPair> flow_node(g, tf::unlimited, [&](const PairJob& job) {
       run.enter(Stage::Flow, job.seq);
       const auto t0 = Clock::now();
@@ -404,7 +424,7 @@ RunReport run_dense(const FrameSource& source, const flow::LkParams& params,
       // One thread per pair: the limiter keeps more pairs in flight than there are threads,
       // and splitting each pair in row tiles as well cost ~15 % of the throughput (measured
       // with pipeline_bench BM_Dense at 2 threads: 171 -> 200 pairs/s without tiles).
-      flow::dense_flow(*job.t.pyramid, *job.t1.pyramid, params, *result);
+      lk_pool.calc(*job.t.pyramid, *job.t1.pyramid, *result);
       run.time("flow", t0);
       return FlowPair{job.seq, job.t.frame, job.t1.frame, std::move(result)};
     });

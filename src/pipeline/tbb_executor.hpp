@@ -2,11 +2,8 @@
 //
 //   using namespace roiflow;
 //   pipeline::TbbExecutor tbb_exec;
-//   flow::FlowOptions options;
-//   options.executor = &tbb_exec;
-//   auto r = pipeline::run_with_threads(2, [&] {
-//     return flow::dense_flow(frame_t, frame_t1, flow::LkParams::paper(), options);
-//   });
+//   flow::DenseLK lk(flow::LkParams::paper(), &tbb_exec);
+//   auto r = pipeline::run_with_threads(2, [&] { return lk.calc(frame_t, frame_t1); });
 //
 // TbbExecutor::for_range runs in whatever task_arena its caller is in, so it owns no threads and
 // one instance can serve every caller. run_with_threads(n, f) runs f in a fresh arena of n

@@ -324,7 +324,7 @@ struct LocalTracker::Impl {
     for (cv::Mat& level : out.pyr.levels) {
       if (level.u != nullptr && level.u->refcount > 1) level.release();
     }
-    flow::build_pyramid(gray(rect), levels, params.lk.sigma, out.pyr);
+    flow::build_pyramid_part(gray, rect, levels, params.lk.sigma, out.pyr);
   }
 
   // Pixels at a part's edges where its values differ from the whole frame's (the smoothing and
@@ -561,10 +561,9 @@ LocalResult LocalTracker::Impl::track(const LocalFrame& in) {
   flow::FlowOptions opt;
   opt.region = r.region - origin;
   opt.initial_motion = velocity;
-  opt.executor = executor;
   opt.context = params.lk_context;
   opt.finest_level = r.level;
-  flow::dense_flow(view_prev, view_cur, params.lk, forward, opt);
+  flow::dense_flow(view_prev, view_cur, params.lk, forward, opt, executor);
   r.region_flow = forward.flow.clone();
 
   // A regular grid over the object's pixels, in frame t-1, and where the flow takes them.
@@ -607,7 +606,7 @@ LocalResult LocalTracker::Impl::track(const LocalFrame& in) {
   if (!opt.region.empty()) {
     flow::LkParams back_lk = params.lk;
     back_lk.levels = std::min(params.lk.levels, params.fb_levels);
-    flow::dense_flow(view_cur, view_prev, back_lk, backward, opt);
+    flow::dense_flow(view_cur, view_prev, back_lk, backward, opt, executor);
     const cv::Point2f back_origin(static_cast<float>(backward.region.x + origin.x),
                                   static_cast<float>(backward.region.y + origin.y));
     const float limit2 = static_cast<float>(params.fb_threshold * params.fb_threshold);

@@ -70,8 +70,7 @@ cv::Rect2f refine_by_motion(const flow::Pyramid& previous, const flow::Pyramid& 
   if (region.width < 8 || region.height < 8) return box;
   flow::FlowOptions options;
   options.region = region;
-  options.executor = executor;
-  const flow::FlowResult r = flow::dense_flow(previous, current, lk, options);
+  const flow::FlowResult r = flow::dense_flow(previous, current, lk, options, executor);
   std::vector<cv::Mat> uv;
   cv::split(r.flow, uv);
   cv::Mat magnitude;

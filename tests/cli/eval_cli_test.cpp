@@ -67,8 +67,8 @@ TEST_F(EvalCliTest, SintelTreeGivesTheHandComputedErrors) {
   const auto rows = csv({"eval", path("MPI-Sintel"), "--format", "csv"});
   ASSERT_EQ(rows.size(), 6u);  // header, 4 pairs, mean
   EXPECT_EQ(rows[0], kExtendedHeader);
-  EXPECT_EQ(rows[1][0], "alley_1/frame_0001");
-  EXPECT_EQ(rows[4][0], "cave_2/frame_0002");
+  EXPECT_EQ(rows[1][0], "alley_1/frame_0001 (clean)");
+  EXPECT_EQ(rows[4][0], "cave_2/frame_0002 (clean)");
   EXPECT_EQ(rows[5][0], "mean");
   for (std::size_t i = 1; i < rows.size(); ++i)
     expect_hand_row(rows[i]);
@@ -76,13 +76,13 @@ TEST_F(EvalCliTest, SintelTreeGivesTheHandComputedErrors) {
   const auto scene = csv({"eval", path("MPI-Sintel"), "--format", "csv", "--pass", "final",
                           "--scene", "cave_2", "--layout", "sintel"});
   ASSERT_EQ(scene.size(), 4u);
-  EXPECT_EQ(scene[1][0], "cave_2/frame_0001");
-  EXPECT_EQ(scene[2][0], "cave_2/frame_0002");
+  EXPECT_EQ(scene[1][0], "cave_2/frame_0001 (final)");
+  EXPECT_EQ(scene[2][0], "cave_2/frame_0002 (final)");
 
   const auto thinned = csv({"eval", path("MPI-Sintel"), "--format", "csv", "--max-pairs", "2"});
   ASSERT_EQ(thinned.size(), 4u);
-  EXPECT_EQ(thinned[1][0], "alley_1/frame_0001");
-  EXPECT_EQ(thinned[2][0], "cave_2/frame_0001");
+  EXPECT_EQ(thinned[1][0], "alley_1/frame_0001 (clean)");
+  EXPECT_EQ(thinned[2][0], "cave_2/frame_0001 (clean)");
 }
 
 TEST_F(EvalCliTest, KittiTreeGivesTheHandComputedErrorsInEveryFormat) {
@@ -107,6 +107,30 @@ TEST_F(EvalCliTest, KittiTreeGivesTheHandComputedErrorsInEveryFormat) {
   ASSERT_EQ(table.exit_code, 0) << table.err;
   EXPECT_NE(table.out.find("Fl-noc(%)"), std::string::npos) << table.out;
   EXPECT_NE(table.out.find("\nmean"), std::string::npos) << table.out;
+}
+
+TEST_F(EvalCliTest, PartialTreesAreEvaluatedWithOneLineOnWhatWasSkipped) {
+  test::write_kitti_tree(dir_ / "kitti", {0, 10});
+  fs::remove(path("kitti/flow_noc/000000_10.png"));
+  const CliResult kitti = run({"eval", path("kitti"), "--format", "csv"});
+  ASSERT_EQ(kitti.exit_code, 0) << kitti.err;
+  EXPECT_EQ(count(kitti.out, "\n"), 4u) << kitti.out;  // header, 2 pairs, mean
+  ASSERT_EQ(count(kitti.err, "\n"), 1u) << kitti.err;
+  EXPECT_EQ(kitti.err.rfind("roiflow: skipped 1: the non-occluded figures of KITTI pair 000000", 0),
+            0u)
+      << kitti.err;
+
+  test::write_sintel_tree(dir_ / "sintel", {"alley_2", "cave_4"}, 1);
+  fs::remove_all(path("sintel/final/alley_2"));
+  fs::remove_all(path("sintel/clean/cave_4"));
+  const CliResult sintel = run({"eval", path("sintel"), "--format", "csv"});
+  ASSERT_EQ(sintel.exit_code, 0) << sintel.err;
+  EXPECT_EQ(sintel.err, "");  // one pass per scene is a complete tree under --pass auto
+  EXPECT_NE(sintel.out.find("\nalley_2/frame_0001 (clean),"), std::string::npos) << sintel.out;
+  EXPECT_NE(sintel.out.find("\ncave_4/frame_0001 (final),"), std::string::npos) << sintel.out;
+  const CliResult clean = run({"eval", path("sintel"), "--pass", "clean", "--format", "csv"});
+  ASSERT_EQ(clean.exit_code, 0) << clean.err;
+  EXPECT_EQ(clean.err, "roiflow: skipped 1: Sintel scene cave_4 (no clean/cave_4/ folder)\n");
 }
 
 TEST_F(EvalCliTest, PairWithKittiGroundTruthShowsFl) {
@@ -137,7 +161,7 @@ TEST_F(EvalCliTest, ReportCoversEveryPairOfEachLayout) {
   };
   const std::vector<Case> cases = {
       {{"eval", path("sintel"), "--report", path("r.html")},
-       {"alley_1/frame_0001", "cave_2/frame_0001"}},
+       {"alley_1/frame_0001 (clean)", "cave_2/frame_0001 (clean)"}},
       {{"eval", path("kitti"), "--report", path("r.html"), "--format", "csv"}, {"000003"}},
       {{"eval", path("mb"), "--report", path("r.html"), "-o", path("e.csv")}, {"Venus"}},
       {{"eval", "--pair", path("mb/Venus/frame10.png"), path("mb/Venus/frame11.png"),
@@ -162,6 +186,8 @@ TEST_F(EvalCliTest, ReportCoversEveryPairOfEachLayout) {
 
 TEST_F(EvalCliTest, BadTreesAndOptionsFailInOneLineLeavingNoFile) {
   test::write_sintel_tree(dir_ / "sintel", {"alley_1"}, 2);
+  // Partial trees are evaluated as far as they go; here nothing is left.
+  fs::remove(path("sintel/clean/alley_1/frame_0001.png"));
   fs::remove(path("sintel/clean/alley_1/frame_0003.png"));
   test::write_kitti_tree(dir_ / "kitti", {0});
   fs::create_directories(path("empty"));

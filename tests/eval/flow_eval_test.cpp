@@ -284,17 +284,17 @@ TEST_F(FlowEvalTest, FindsSintelPairsWithMasksSortedBySceneAndFrame) {
   const std::vector<EvalPair> pairs = find_sintel(dir_.string());
   ASSERT_EQ(pairs.size(), 4u);
   const fs::path root = dir_ / "training";
-  EXPECT_EQ(pairs[0].name, "alley_1/frame_0001");
+  EXPECT_EQ(pairs[0].name, "alley_1/frame_0001 (clean)");
   EXPECT_EQ(pairs[0].frame0, (root / "clean/alley_1/frame_0001.png").string());
   EXPECT_EQ(pairs[0].frame1, (root / "clean/alley_1/frame_0002.png").string());
   EXPECT_EQ(pairs[0].ground_truth, (root / "flow/alley_1/frame_0001.flo").string());
   EXPECT_EQ(pairs[0].occlusion_mask, (root / "occlusions/alley_1/frame_0001.png").string());
   EXPECT_EQ(pairs[0].exclude_mask, (root / "invalid/alley_1/frame_0001.png").string());
   EXPECT_TRUE(pairs[0].noc_ground_truth.empty());
-  EXPECT_EQ(pairs[1].name, "alley_1/frame_0002");
+  EXPECT_EQ(pairs[1].name, "alley_1/frame_0002 (clean)");
   EXPECT_EQ(pairs[1].frame1, (root / "clean/alley_1/frame_0003.png").string());
-  EXPECT_EQ(pairs[2].name, "cave_2/frame_0001");
-  EXPECT_EQ(pairs[3].name, "cave_2/frame_0002");
+  EXPECT_EQ(pairs[2].name, "cave_2/frame_0001 (clean)");
+  EXPECT_EQ(pairs[3].name, "cave_2/frame_0002 (clean)");
 
   const std::vector<EvalPair> final_pass = find_sintel(dir_.string(), "final");
   EXPECT_EQ(final_pass[3].frame0, (root / "final/cave_2/frame_0002.png").string());
@@ -373,6 +373,101 @@ TEST_F(FlowEvalTest, BrokenKittiTreesNameWhatIsMissing) {
             std::string::npos);
 }
 
+// A partial download: one pass per scene, a pair without its second frame, a pair without its
+// occlusion mask, a scene in no pass at all. Every gap is reported, nothing else is lost.
+TEST_F(FlowEvalTest, PartialSintelTreesEvaluateWhatIsThereAndSayWhatWasSkipped) {
+  test::write_sintel_tree(dir_, {"alley_1", "cave_2", "market_5"}, 2);
+  fs::remove_all(path("final/alley_1"));   // alley_1: clean only
+  fs::remove_all(path("clean/cave_2"));    // cave_2: final only
+  fs::remove_all(path("clean/market_5"));  // market_5: no pass at all
+  fs::remove_all(path("final/market_5"));
+  fs::remove(path("final/cave_2/frame_0003.png"));        // cave_2/frame_0002: no frame 1
+  fs::remove(path("occlusions/alley_1/frame_0002.png"));  // alley_1/frame_0002: no noc
+
+  std::vector<std::string> skipped;
+  const std::vector<EvalPair> pairs = find_sintel(dir_.string(), "auto", &skipped);
+  ASSERT_EQ(pairs.size(), 3u);
+  EXPECT_EQ(pairs[0].name, "alley_1/frame_0001 (clean)");
+  EXPECT_EQ(pairs[1].name, "alley_1/frame_0002 (clean)");
+  EXPECT_TRUE(pairs[1].occlusion_mask.empty());
+  EXPECT_EQ(pairs[1].exclude_mask, path("invalid/alley_1/frame_0002.png"));
+  EXPECT_EQ(pairs[2].name, "cave_2/frame_0001 (final)");
+  EXPECT_EQ(pairs[2].frame0, path("final/cave_2/frame_0001.png"));
+  ASSERT_EQ(skipped.size(), 3u);
+  EXPECT_EQ(skipped[0].rfind("the non-occluded figures of Sintel pair alley_1/frame_0002 (", 0), 0u)
+      << skipped[0];
+  EXPECT_NE(skipped[0].find("occlusions/alley_1/frame_0002.png"), std::string::npos);
+  EXPECT_EQ(skipped[1].rfind("Sintel pair cave_2/frame_0002 (missing file '", 0), 0u) << skipped[1];
+  EXPECT_NE(skipped[1].find("final/cave_2/frame_0003.png"), std::string::npos);
+  EXPECT_EQ(skipped[2], "Sintel scene market_5 (no clean/, final/ or albedo/ folder of the scene)");
+  const std::string line = skipped_line(skipped);
+  EXPECT_EQ(line.rfind("skipped 3: the non-occluded", 0), 0u) << line;
+  EXPECT_EQ(line.find('\n'), std::string::npos);
+  EXPECT_EQ(skipped_line({}), "");
+
+  // The non-occluded figures are missing only where the mask is.
+  const EvalRow no_noc = evaluate_pair(pairs[1], flow::LkParams::paper());
+  EXPECT_FALSE(no_noc.noc.has_value());
+  EXPECT_EQ(no_noc.errors.pixels, test::kHandPixelsAll);
+  EXPECT_TRUE(evaluate_pair(pairs[0], flow::LkParams::paper()).noc.has_value());
+
+  // A named pass keeps to it: the scenes without it are skipped, each said.
+  skipped.clear();
+  const std::vector<EvalPair> final_pass = find_sintel(dir_.string(), "final", &skipped);
+  ASSERT_EQ(final_pass.size(), 1u);
+  EXPECT_EQ(final_pass[0].name, "cave_2/frame_0001 (final)");
+  ASSERT_EQ(skipped.size(), 3u);
+  EXPECT_EQ(skipped[0], "Sintel scene alley_1 (no final/alley_1/ folder)");
+
+  // Strict (no list): the first gap is an error naming the file, as before.
+  const std::string message = error_of([&] { find_sintel(dir_.string()); });
+  EXPECT_NE(message.find("occlusions/alley_1/frame_0002.png"), std::string::npos) << message;
+
+  // Nothing evaluable is an error that says why.
+  fs::remove(path("final/cave_2/frame_0001.png"));
+  fs::remove_all(path("clean/alley_1"));
+  skipped.clear();
+  const std::string none = error_of([&] { find_sintel(dir_.string(), "auto", &skipped); });
+  EXPECT_NE(none.find("no Sintel pair to evaluate"), std::string::npos) << none;
+  EXPECT_NE(none.find("Sintel scene alley_1"), std::string::npos) << none;
+}
+
+TEST_F(FlowEvalTest, PartialKittiTreesEvaluateWhatIsThereAndSayWhatWasSkipped) {
+  test::write_kitti_tree(dir_, {0, 10, 20}, "image_2");
+  fs::remove(path("flow_noc/000000_10.png"));  // 000000: all pixels only (as shipped)
+  fs::remove(path("image_2/000020_11.png"));   // 000020: no second frame
+  test::write_png(dir_ / "flow_noc/000030_10.png",
+                  encode_kitti_flow(cv::Mat(test::kHandSize, CV_32FC2, cv::Scalar(1, 0))));
+
+  std::vector<std::string> skipped;
+  const std::vector<EvalPair> pairs = find_pairs(dir_.string(), {}, &skipped);
+  ASSERT_EQ(pairs.size(), 2u);
+  EXPECT_EQ(pairs[0].name, "000000");
+  EXPECT_TRUE(pairs[0].noc_ground_truth.empty());
+  EXPECT_EQ(pairs[1].name, "000010");
+  EXPECT_EQ(pairs[1].noc_ground_truth, path("flow_noc/000010_10.png"));
+  ASSERT_EQ(skipped.size(), 3u);
+  EXPECT_EQ(skipped[0].rfind("the non-occluded figures of KITTI pair 000000 (missing file", 0), 0u)
+      << skipped[0];
+  EXPECT_EQ(skipped[1].rfind("KITTI pair 000020 (missing file", 0), 0u) << skipped[1];
+  EXPECT_NE(skipped[1].find("000020_11.png"), std::string::npos) << skipped[1];
+  EXPECT_EQ(skipped[2],
+            "KITTI pair 000030 (flow_noc/000030_10.png without flow_occ/000030_10.png)");
+
+  const EvalRow all_only = evaluate_pair(pairs[0], flow::LkParams::paper());
+  EXPECT_FALSE(all_only.noc.has_value());
+  EXPECT_NEAR(all_only.errors.epe, test::kHandEpeAll, 1e-6);
+  EXPECT_NEAR(mean_row({all_only, evaluate_pair(pairs[1], flow::LkParams::paper())}).noc->epe,
+              test::kHandEpeNoc, 1e-6);
+
+  fs::remove(path("image_2/000000_10.png"));
+  fs::remove(path("image_2/000010_10.png"));
+  skipped.clear();
+  const std::string none = error_of([&] { find_kitti(dir_.string(), &skipped); });
+  EXPECT_NE(none.find("no KITTI pair to evaluate"), std::string::npos) << none;
+  EXPECT_NE(none.find("000010_10.png"), std::string::npos) << none;
+}
+
 TEST_F(FlowEvalTest, FindPairsFiltersBySceneThinsEvenlyAndHonoursTheLayout) {
   test::write_sintel_tree(dir_, {"alley_1", "bamboo_1", "cave_2"}, 4);
   EXPECT_EQ(find_pairs(dir_.string()).size(), 12u);
@@ -388,9 +483,9 @@ TEST_F(FlowEvalTest, FindPairsFiltersBySceneThinsEvenlyAndHonoursTheLayout) {
   options.max_pairs = 3;  // one from each scene, not the first three of alley_1
   const std::vector<EvalPair> three = find_pairs(dir_.string(), options);
   ASSERT_EQ(three.size(), 3u);
-  EXPECT_EQ(three[0].name, "alley_1/frame_0001");
-  EXPECT_EQ(three[1].name, "bamboo_1/frame_0001");
-  EXPECT_EQ(three[2].name, "cave_2/frame_0001");
+  EXPECT_EQ(three[0].name, "alley_1/frame_0001 (clean)");
+  EXPECT_EQ(three[1].name, "bamboo_1/frame_0001 (clean)");
+  EXPECT_EQ(three[2].name, "cave_2/frame_0001 (clean)");
   options.max_pairs = 50;
   EXPECT_EQ(find_pairs(dir_.string(), options).size(), 12u);
 

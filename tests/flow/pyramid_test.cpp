@@ -216,6 +216,53 @@ TEST(PyramidTest, SigmaOutOfRangeThrows) {
   EXPECT_NE(error_message([&] { build_pyramid(image, 1, -0.5); }).find("-0.5"), std::string::npos);
 }
 
+TEST(PyramidTest, LevelByLevelEqualsTheWholeBuildAndReusesBuffers) {
+  const cv::Mat image = random_image({101, 77}, CV_8UC1, 4);
+  const Pyramid whole = build_pyramid(image, 4, 0.8);
+  Pyramid steps;
+  for (int round = 0; round < 2; ++round) {
+    std::vector<const uchar*> before;
+    for (const cv::Mat& level : steps.levels)
+      before.push_back(level.data);
+    build_base_level(image, 4, 0.8, steps);
+    ASSERT_EQ(steps.num_levels(), whole.num_levels());
+    for (int l = 1; l < steps.num_levels(); ++l)
+      build_level(steps, l);
+    for (int l = 0; l < steps.num_levels(); ++l) {
+      EXPECT_EQ(cv::norm(steps.levels[l], whole.levels[l], cv::NORM_INF), 0.0) << l;
+      if (round == 1) {
+        EXPECT_EQ(steps.levels[l].data, before[l]) << l;
+      }
+    }
+  }
+  EXPECT_THROW(build_level(steps, 0), Error);
+  EXPECT_THROW(build_level(steps, steps.num_levels()), Error);
+}
+
+TEST(PyramidTest, APartOnTheCoarsestGridIsThePyramidOfThePart) {
+  const cv::Mat image = random_image({120, 90}, CV_8UC1, 5);
+  const Pyramid whole = build_pyramid(image, 3, 0.5);
+  const cv::Rect rect(24, 8, 61, 50);  // origin on multiples of 4
+  Pyramid part;
+  build_pyramid_part(image, rect, 3, 0.5, part);
+  const Pyramid expected = build_pyramid(image(rect), 3, 0.5);
+  ASSERT_EQ(part.num_levels(), 3);
+  for (int l = 0; l < 3; ++l) {
+    EXPECT_EQ(cv::norm(part.levels[l], expected.levels[l], cv::NORM_INF), 0.0) << l;
+    // Away from the part's edges it is the frame's own pyramid.
+    const cv::Rect at = part_level_rect(rect, l);
+    EXPECT_EQ(part.levels[l].size(), at.size()) << l;
+    const cv::Rect inner(4, 4, at.width - 8, at.height - 8);
+    EXPECT_LT(cv::norm(part.levels[l](inner), whole.levels[l](inner + at.tl()), cv::NORM_INF), 1e-6)
+        << l;
+  }
+  for (const cv::Rect bad : {cv::Rect(2, 8, 40, 40), cv::Rect(24, 6, 40, 40),
+                             cv::Rect(100, 8, 40, 40), cv::Rect(24, 8, 0, 40)}) {
+    const std::string msg = error_message([&] { build_pyramid_part(image, bad, 3, 0.5, part); });
+    EXPECT_NE(msg.find("multiple of 4"), std::string::npos) << msg;
+  }
+}
+
 TEST(PyramidTest, IdenticalFramesGiveZeroFlow) {
   for (const cv::Size size : {cv::Size(160, 120), cv::Size(33, 17)}) {
     const Pair s = moving_pair(size, 5);

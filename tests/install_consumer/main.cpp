@@ -23,13 +23,14 @@ int main() {
   cv::Mat border(size, CV_8UC1, cv::Scalar(255));
   border(cv::Rect(16, 16, size.width - 32, size.height - 32)).setTo(0);
 
-  flow::FlowOptions options;
 #ifdef CONSUMER_WITH_PIPELINE
-  const pipeline::TbbExecutor executor;
-  options.executor = &executor;
+  const pipeline::TbbExecutor tbb;
+  const Executor* executor = &tbb;
+#else
+  const Executor* executor = nullptr;
 #endif
-  const flow::FlowResult result =
-      flow::dense_flow(frame0, frame1, flow::LkParams::paper(), options);
+  flow::DenseLK lk(flow::LkParams::paper(), executor);
+  const flow::FlowResult result = lk.calc(frame0, frame1);
   const flow::FlowErrors errors = flow::flow_errors(result.flow, truth, border);
   std::printf("installed roiflow: EPE %.4f px over %lld pixels\n", errors.epe,
               static_cast<long long>(errors.pixels));

@@ -55,10 +55,8 @@ TEST(DenseLkTest, TbbStripesGiveTheSerialResult) {
       FlowOptions serial_options;
       serial_options.region = region;
       const FlowResult serial = dense_flow(s.frame0, s.frame1, c.params, serial_options);
-      FlowOptions options = serial_options;
-      options.executor = &tbb_exec;
       const FlowResult parallel = pipeline::run_with_threads(
-          2, [&] { return dense_flow(s.frame0, s.frame1, c.params, options); });
+          2, [&] { return dense_flow(s.frame0, s.frame1, c.params, serial_options, &tbb_exec); });
       EXPECT_EQ(parallel.region, serial.region);
       EXPECT_LT(max_abs_diff(parallel.flow, serial.flow), 1e-5) << c.name << " " << region;
       EXPECT_LT(max_abs_diff(parallel.confidence, serial.confidence), 1e-6)
@@ -71,12 +69,10 @@ TEST(DenseLkTest, TbbStripesGiveTheSerialResult) {
 TEST(DenseLkTest, TbbStripesAreDeterministic) {
   const Scene s = make_scene(SceneKind::NonRigid, kSize, 13);
   const pipeline::TbbExecutor tbb_exec;
-  FlowOptions options;
-  options.executor = &tbb_exec;
   for (const NamedParams& c : configurations()) {
     const auto run = [&] {
       return pipeline::run_with_threads(
-          2, [&] { return dense_flow(s.frame0, s.frame1, c.params, options); });
+          2, [&] { return dense_flow(s.frame0, s.frame1, c.params, {}, &tbb_exec); });
     };
     const FlowResult a = run(), b = run();
     EXPECT_EQ(max_abs_diff(a.flow, b.flow), 0.0) << c.name;
