@@ -23,7 +23,10 @@ class UsageError : public Error {
 // Overrides stay empty unless given, so they apply on top of whichever preset was chosen.
 struct LkOptions {
   std::string preset = "paper";
-  std::optional<int> patch, levels, iterations, level_median, final_median;
+  std::optional<int> patch, iterations, level_median, final_median;
+  std::optional<std::string> levels;  // N or "auto"
+  std::optional<int> search_radius, fuse_step, fuse_finest_level, mask_outside, finest_level;
+  std::optional<double> expected_motion;
   std::optional<double> sigma, lambda, robust_scale;
   std::optional<std::string> derivative;
   int threads = 1;

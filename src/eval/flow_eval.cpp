@@ -651,7 +651,13 @@ nlohmann::ordered_json params_json(const flow::LkParams& params) {
           {"lambda", params.lambda},
           {"robust_scale", params.robust_scale},
           {"level_median", params.level_median},
-          {"final_median", params.final_median}};
+          {"final_median", params.final_median},
+          {"expected_motion", params.expected_motion},
+          {"search_radius", params.search_radius},
+          {"fuse_step", params.fuse_step},
+          {"fuse_finest_level", params.fuse_finest_level},
+          {"mask_outside", params.mask_outside},
+          {"finest_level", params.finest_level}};
 }
 
 }  // namespace roiflow::eval

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "flow/large_motion.hpp"
 #include "flow/lk_level.hpp"
 
 namespace roiflow::flow {
@@ -69,7 +70,7 @@ LevelPlan plan_levels(cv::Size size, const LkParams& params, const FlowOptions& 
   }
   LevelPlan plan;
   plan.top = flow_pyramid_levels(size, params, options);
-  plan.finest = std::min(options.finest_level, plan.top - 1);
+  plan.finest = std::min(std::max(options.finest_level, params.finest_level), plan.top - 1);
   const Window win = make_window(params.patch, params.derivative == Derivative::HornSchunck);
   // Flow at a pixel after one iteration depends on the previous flow within the window plus
   // the derivative stencil: computing on a margin of this many pixels per iteration makes a
@@ -146,6 +147,7 @@ LevelProblem level_problem(const cv::Mat& i0, const cv::Mat& i1, const cv::Rect&
   p.robust_inv_scale2 = params.robust_scale > 0
                             ? static_cast<float>(1.0 / (params.robust_scale * params.robust_scale))
                             : 0.f;
+  p.mask_outside = params.mask_outside;
   // Windows are clipped at the computed rectangle; near the image border that is the
   // image border, elsewhere only pixels outside the wanted region are affected.
   p.inv_cx.resize(c.width);
@@ -196,6 +198,7 @@ void flow_from_pyramids(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkPar
       upsample_flow(ws.v[l + 1], comp[l + 1].tl(), c, v);
     }
     if (l < plan.finest) continue;  // below the finest level the flow is only upsampled
+    detail::seed_level(params, pyr_t.levels[l], pyr_t1.levels[l], c, l, levels, options, u, v);
     const LevelProblem p = level_problem(pyr_t.levels[l], pyr_t1.levels[l], c, params);
     const bool finest = l == plan.finest;
     if (finest) confidence.create(c.size(), CV_32F);
@@ -233,8 +236,10 @@ cv::Rect flow_footprint(cv::Size size, const LkParams& params, const FlowOptions
 }
 
 int flow_pyramid_levels(cv::Size size, const LkParams& params, const FlowOptions& options) {
-  const int finest = std::clamp(options.finest_level, 0, kMaxLevels - 1);
-  const int top = std::max(params.levels, finest + std::min(params.levels, 2));
+  const int finest =
+      std::clamp(std::max(options.finest_level, params.finest_level), 0, kMaxLevels - 1);
+  const int levels = detail::requested_levels(size, params);
+  const int top = std::max(levels, finest + std::min(levels, 2));
   return effective_levels(size, std::min(kMaxLevels, top));
 }
 

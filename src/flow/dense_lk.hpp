@@ -42,7 +42,7 @@ enum class Derivative {
 
 struct LkParams {
   int patch = 10;      // window side in pixels, 3..31, even sizes allowed (see above)
-  int levels = 3;      // pyramid levels, 1..6 (fewer when the image is small)
+  int levels = 3;      // pyramid levels, 1..6 (fewer when the image is small); 0 = auto
   int iterations = 3;  // refinement iterations per level, 1..50
   double sigma = 0.5;  // pretreatment Gaussian sigma in pixels, 0 = off
   Derivative derivative = Derivative::HornSchunck;
@@ -54,10 +54,27 @@ struct LkParams {
   double robust_scale = 0.0;
   int level_median = 0;  // median filter (0 off, 3, 5) of the flow after each coarse level
   int final_median = 0;  // median filter (0 off, 3, 5) of the final flow
+  // Large displacements (large_motion.hpp). levels = 0 (auto) picks the levels from the frame
+  // size and the expected motion.
+  double expected_motion = 0.0;  // level-0 pixels, >= 0; 0 = a quarter of the larger side
+  // Coarse search at the coarsest level: the largest radius, in that level's pixels
+  // (0 = off, at most kMaxSearchRadius); the radius used covers the expected motion.
+  int search_radius = 0;
+  // Candidate fusion before the iterations of levels fuse_finest_level .. coarsest: each pixel
+  // may take the flow of the pixels fuse_step away (that level's pixels; 0 = off, at most 32).
+  int fuse_step = 0;
+  int fuse_finest_level = 0;
+  // Samples of frame t+1 that fall outside the frame carry no brightness term (It = 0): the
+  // pixels moving out of view keep the flow their neighbours give them.
+  bool mask_outside = false;
+  // Level LK stops at (as FlowOptions::finest_level, which can only raise it): the finer
+  // levels get the upsampled flow. 0..kMaxLevels - 1.
+  int finest_level = 0;
 
   static LkParams paper();     // patch 10, levels 3, iterations 3, Horn–Schunck
   static LkParams accurate();  // tuned for the lowest error on real data
-  // "paper" or "accurate"; throws roiflow::Error naming the unknown preset.
+  static LkParams fast();      // realtime with large motions: search, fusion, LK to level 1
+  // "paper", "accurate" or "fast"; throws roiflow::Error naming the unknown preset.
   static LkParams preset(std::string_view name);
   static std::vector<std::string> preset_names();
 

@@ -4,6 +4,8 @@
 #include <cstddef>
 #include <vector>
 
+#include "flow/large_motion.hpp"
+
 namespace roiflow::flow::detail {
 
 Window make_window(int patch, bool half_pixel_grid) {
@@ -178,6 +180,11 @@ class RowIterator {
     warp_row(*p_.i1, p_.i0->ptr<float>(gy) + p_.comp.x, p_.comp.x, gy, w_,
              u_old_ + static_cast<size_t>(r) * w_, v_old_ + static_cast<size_t>(r) * w_,
              e.m.data() + 1, e.d.data() + 1);
+    if (p_.mask_outside) {
+      mask_outside_row(*p_.i1, p_.i0->ptr<float>(gy) + p_.comp.x, p_.comp.x, gy, w_,
+                       u_old_ + static_cast<size_t>(r) * w_, v_old_ + static_cast<size_t>(r) * w_,
+                       e.m.data() + 1, e.d.data() + 1);
+    }
     e.u = u_old_ + static_cast<size_t>(r) * w_;
     e.v = v_old_ + static_cast<size_t>(r) * w_;
     for (auto* vec : {&e.m, &e.d}) {

@@ -12,8 +12,8 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
-#include "flow/dense_lk.hpp"
 #include "core/executor.hpp"
+#include "flow/dense_lk.hpp"
 #include "flow/lk_rows.hpp"
 
 namespace roiflow::flow::detail {
@@ -40,6 +40,7 @@ struct LevelProblem {
   Window win;
   float lambda = 0.f;
   float robust_inv_scale2 = 0.f;  // 1 / robust_scale^2, 0 = least squares
+  bool mask_outside = false;      // LkParams::mask_outside
   std::vector<float> inv_cx;      // 1 / horizontal window weight per column
   std::vector<float> cy;          // vertical window weight per row
 };

@@ -1,9 +1,11 @@
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
-#include "flow/dense_lk.hpp"
 #include "core/error.hpp"
+#include "flow/dense_lk.hpp"
+#include "flow/large_motion.hpp"
 #include "flow/pyramid.hpp"
 
 namespace roiflow::flow {
@@ -18,29 +20,49 @@ LkParams LkParams::paper() {
 // and at the end remove isolated outliers.
 LkParams LkParams::accurate() {
   LkParams p;
-  p.levels = 5;
+  p.levels = 0;
   p.iterations = 8;
   p.robust_scale = 0.008;
   p.level_median = 5;
   p.final_median = 5;
+  p.search_radius = 12;
+  p.fuse_step = 6;
+  p.mask_outside = true;
+  return p;
+}
+
+LkParams LkParams::fast() {
+  LkParams p;
+  p.levels = 0;
+  p.iterations = 3;
+  p.robust_scale = 0.008;
+  p.level_median = 5;
+  p.final_median = 5;
+  p.search_radius = 12;
+  p.fuse_step = 6;
+  p.fuse_finest_level = 2;
+  p.mask_outside = true;
+  p.finest_level = 1;
   return p;
 }
 
 LkParams LkParams::preset(std::string_view name) {
   if (name == "paper") return paper();
   if (name == "accurate") return accurate();
-  throw Error("unknown preset '" + std::string(name) + "' (expected paper or accurate)");
+  if (name == "fast") return fast();
+  throw Error("unknown preset '" + std::string(name) + "' (expected paper, accurate or fast)");
 }
 
 std::vector<std::string> LkParams::preset_names() {
-  return {"paper", "accurate"};
+  return {"paper", "accurate", "fast"};
 }
 
 void LkParams::validate() const {
   auto fail = [](const std::string& what) { throw Error(what); };
   if (patch < 3 || patch > 31) fail("patch must be in 3..31, got " + std::to_string(patch));
-  if (levels < 1 || levels > kMaxLevels) {
-    fail("levels must be in 1.." + std::to_string(kMaxLevels) + ", got " + std::to_string(levels));
+  if (levels < 0 || levels > kMaxLevels) {
+    fail("levels must be in 1.." + std::to_string(kMaxLevels) + " or 0 (auto), got " +
+         std::to_string(levels));
   }
   if (iterations < 1 || iterations > 50) {
     fail("iterations must be in 1..50, got " + std::to_string(iterations));
@@ -56,6 +78,24 @@ void LkParams::validate() const {
   for (int m : {level_median, final_median}) {
     if (m != 0 && m != 3 && m != 5) {
       fail("median filter size must be 0, 3 or 5, got " + std::to_string(m));
+    }
+  }
+  if (!(expected_motion >= 0.0 && expected_motion <= 1e5)) {
+    fail("expected motion must be in [0, 100000] pixels (0 = from the frame size), got " +
+         std::to_string(expected_motion));
+  }
+  if (search_radius < 0 || search_radius > kMaxSearchRadius) {
+    fail("search radius must be in 0.." + std::to_string(kMaxSearchRadius) + " (0 = off), got " +
+         std::to_string(search_radius));
+  }
+  if (fuse_step < 0 || fuse_step > 32) {
+    fail("fuse step must be in 0..32 (0 = off), got " + std::to_string(fuse_step));
+  }
+  for (const auto& [name, level] : {std::pair{"fuse finest level", fuse_finest_level},
+                                    std::pair{"finest level", finest_level}}) {
+    if (level < 0 || level >= kMaxLevels) {
+      fail(std::string(name) + " must be in 0.." + std::to_string(kMaxLevels - 1) + ", got " +
+           std::to_string(level));
     }
   }
 }
