@@ -39,12 +39,25 @@ void add_lk_options(CLI::App& cmd, LkOptions& lk) {
                  "coarse search at the coarsest level: largest radius in its pixels (0 = off)")
       ->check(CLI::Range(0, flow::kMaxSearchRadius))
       ->group(group);
+  cmd.add_option("--coarsest-side", lk.coarsest_side,
+                 "--levels auto: the coarsest level's shorter side, pixels")
+      ->check(CLI::Range(flow::kMinLevelSide, 480))
+      ->group(group);
+  cmd.add_option("--fuse-far-step", lk.fuse_far_step,
+                 "candidate fusion before each level, first pass: neighbours this many pixels "
+                 "away (0 = off)")
+      ->check(CLI::Range(0, 32))
+      ->group(group);
+  cmd.add_option("--fuse-far-finest-level", lk.fuse_far_finest_level,
+                 "finest pyramid level the first fusion pass runs on")
+      ->check(CLI::Range(0, flow::kMaxLevels - 1))
+      ->group(group);
   cmd.add_option("--fuse-step", lk.fuse_step,
-                 "candidate fusion before each level: neighbours this many pixels away (0 = off)")
+                 "candidate fusion, second pass: neighbours this many pixels away (0 = off)")
       ->check(CLI::Range(0, 32))
       ->group(group);
   cmd.add_option("--fuse-finest-level", lk.fuse_finest_level,
-                 "finest pyramid level the candidate fusion runs on")
+                 "finest pyramid level the second fusion pass runs on")
       ->check(CLI::Range(0, flow::kMaxLevels - 1))
       ->group(group);
   cmd.add_option("--mask-outside", lk.mask_outside,
@@ -87,6 +100,9 @@ flow::LkParams lk_params(const LkOptions& lk) {
   if (lk.levels) params.levels = *lk.levels == "auto" ? 0 : std::stoi(*lk.levels);
   if (lk.expected_motion) params.expected_motion = *lk.expected_motion;
   if (lk.search_radius) params.search_radius = *lk.search_radius;
+  if (lk.coarsest_side) params.coarsest_side = *lk.coarsest_side;
+  if (lk.fuse_far_step) params.fuse_far_step = *lk.fuse_far_step;
+  if (lk.fuse_far_finest_level) params.fuse_far_finest_level = *lk.fuse_far_finest_level;
   if (lk.fuse_step) params.fuse_step = *lk.fuse_step;
   if (lk.fuse_finest_level) params.fuse_finest_level = *lk.fuse_finest_level;
   if (lk.mask_outside) params.mask_outside = *lk.mask_outside != 0;

@@ -25,7 +25,8 @@ struct LkOptions {
   std::string preset = "paper";
   std::optional<int> patch, iterations, level_median, final_median;
   std::optional<std::string> levels;  // N or "auto"
-  std::optional<int> search_radius, fuse_step, fuse_finest_level, mask_outside, finest_level;
+  std::optional<int> coarsest_side, search_radius, fuse_far_step, fuse_far_finest_level;
+  std::optional<int> fuse_step, fuse_finest_level, mask_outside, finest_level;
   std::optional<double> expected_motion;
   std::optional<double> sigma, lambda, robust_scale;
   std::optional<std::string> derivative;

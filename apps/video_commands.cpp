@@ -388,6 +388,13 @@ std::vector<std::string> child_args(const TrackCommand& cmd, const std::string& 
   if (lk.levels) a.insert(a.end(), {"--levels", *lk.levels});
   if (lk.expected_motion) a.insert(a.end(), {"--expected-motion", exact(*lk.expected_motion)});
   if (lk.search_radius) a.insert(a.end(), {"--search-radius", std::to_string(*lk.search_radius)});
+  if (lk.coarsest_side) {
+    a.insert(a.end(), {"--coarsest-side", std::to_string(*lk.coarsest_side)});
+  }
+  if (lk.fuse_far_step) a.insert(a.end(), {"--fuse-far-step", std::to_string(*lk.fuse_far_step)});
+  if (lk.fuse_far_finest_level) {
+    a.insert(a.end(), {"--fuse-far-finest-level", std::to_string(*lk.fuse_far_finest_level)});
+  }
   if (lk.fuse_step) a.insert(a.end(), {"--fuse-step", std::to_string(*lk.fuse_step)});
   if (lk.fuse_finest_level) {
     a.insert(a.end(), {"--fuse-finest-level", std::to_string(*lk.fuse_finest_level)});

@@ -55,13 +55,18 @@ struct LkParams {
   int level_median = 0;  // median filter (0 off, 3, 5) of the flow after each coarse level
   int final_median = 0;  // median filter (0 off, 3, 5) of the final flow
   // Large displacements (large_motion.hpp). levels = 0 (auto) picks the levels from the frame
-  // size and the expected motion.
+  // size and the expected motion: the coarsest level keeps a shorter side of coarsest_side
+  // pixels (12..480).
   double expected_motion = 0.0;  // level-0 pixels, >= 0; 0 = a quarter of the larger side
+  int coarsest_side = 40;
   // Coarse search at the coarsest level: the largest radius, in that level's pixels
   // (0 = off, at most kMaxSearchRadius); the radius used covers the expected motion.
   int search_radius = 0;
-  // Candidate fusion before the iterations of levels fuse_finest_level .. coarsest: each pixel
-  // may take the flow of the pixels fuse_step away (that level's pixels; 0 = off, at most 32).
+  // Candidate fusion before the iterations of a level: each pixel may take the flow of the
+  // pixels fuse_far_step, then fuse_step, away (that level's pixels; 0 = off, at most 32), on
+  // the levels from fuse_far_finest_level and fuse_finest_level up to the coarsest.
+  int fuse_far_step = 0;
+  int fuse_far_finest_level = 0;
   int fuse_step = 0;
   int fuse_finest_level = 0;
   // Samples of frame t+1 that fall outside the frame carry no brightness term (It = 0): the

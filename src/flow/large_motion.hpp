@@ -3,7 +3,7 @@
 // candidate fusion that carries a motion found in one part of an object over to the rest.
 //
 //   using namespace roiflow::flow;
-//   const int levels = auto_levels({1242, 375}, /*expected_motion=*/0.0);      // 4
+//   const int levels = auto_levels({1242, 375}, /*expected_motion=*/0.0);      // 4 levels
 //   cv::Mat u(i0.size(), CV_32F, 0.f), v(i0.size(), CV_32F, 0.f);
 //   search_flow(i0, i1, {0.f, 0.f}, SearchParams{.radius = 12}, u, v);         // coarsest level
 //   fuse_candidates(i0, i1, /*step=*/6, /*window=*/7, u, v);                   // any level
@@ -31,7 +31,7 @@
 
 namespace roiflow::flow {
 
-// The shorter side, in pixels, that auto_levels keeps for the coarsest level.
+// The shorter side, in pixels, that auto_levels keeps for the coarsest level by default.
 inline constexpr int kCoarsestSide = 40;
 // The largest search radius LkParams accept, in pixels of the coarsest level.
 inline constexpr int kMaxSearchRadius = 24;
@@ -39,10 +39,10 @@ inline constexpr int kMaxSearchRadius = 24;
 inline constexpr int kFuseWindow = 7;
 
 // Levels for a frame of `size` (LkParams::levels = 0): the coarsest level is the deepest whose
-// shorter side keeps kCoarsestSide pixels, so that a search there still sees objects; when
-// `expected_motion` (> 0, level-0 pixels) is small, fewer levels, as long as the coarsest still
-// sees the motion as at most two of its pixels. 1..kMaxLevels.
-int auto_levels(cv::Size size, double expected_motion);
+// shorter side keeps `coarsest_side` pixels (at least kMinLevelSide), so that a search there
+// still sees objects; when `expected_motion` (> 0, level-0 pixels) is small, fewer levels, as
+// long as the coarsest still sees the motion as at most two of its pixels. 1..kMaxLevels.
+int auto_levels(cv::Size size, double expected_motion, int coarsest_side = kCoarsestSide);
 
 // The search radius, in pixels of coarsest level `level`, that covers `expected_motion`
 // (level-0 pixels; <= 0: a quarter of the frame's larger side), at most `max_radius`.
@@ -77,8 +77,9 @@ int requested_levels(cv::Size size, const LkParams& params);
 
 // dense_flow's hook before the iterations of level `level` (of `levels`; i0, i1: its whole
 // images), on the rectangle `c` that u and v cover: the coarse search at the coarsest level
-// (around options.initial_motion; not when options.initial_flow gives the start) and the
-// candidate fusion, as `params` ask. A region is searched within its own rectangle.
+// (around options.initial_motion; not when options.initial_flow gives the start), then the far
+// and the near candidate fusion, as `params` ask. A region is searched within its own
+// rectangle.
 void seed_level(const LkParams& params, const cv::Mat& i0, const cv::Mat& i1, const cv::Rect& c,
                 int level, int levels, const FlowOptions& options, cv::Mat& u, cv::Mat& v);
 

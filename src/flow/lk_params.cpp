@@ -14,35 +14,44 @@ LkParams LkParams::paper() {
   return LkParams{};
 }
 
-// Measured on the 8 Middlebury sequences (mean EPE, see README): from `paper`, 5 levels
-// reach the large motions, 8 iterations let the robust weights settle, Cauchy reweighting
-// (scale 0.008) discounts occlusions and motion boundaries, and 5x5 medians between levels
-// and at the end remove isolated outliers.
+// Chosen on Middlebury, KITTI, Sintel and FlyingChairs together (docs/ACCURACY.md): 8
+// iterations let the robust weights settle, Cauchy reweighting (scale 0.008) discounts
+// occlusions and motion boundaries, 5x5 medians between levels and at the end remove isolated
+// outliers; the coarse search and the candidate fusion follow motions larger than a patch, and
+// an 8x8 patch keeps motion boundaries sharper than the paper's 10x10.
 LkParams LkParams::accurate() {
   LkParams p;
+  p.patch = 8;
   p.levels = 0;
   p.iterations = 8;
   p.robust_scale = 0.008;
   p.level_median = 5;
   p.final_median = 5;
-  p.search_radius = 12;
+  p.search_radius = 14;
+  p.fuse_far_step = 16;
   p.fuse_step = 6;
+  p.fuse_finest_level = 1;
   p.mask_outside = true;
   return p;
 }
 
+// The realtime choice for large motions, set as DIS ULTRAFAST is: the search on a coarser level
+// (shorter side 20 px), LK from there down to level 2 (a quarter of the resolution) and the
+// flow upsampled; the candidate fusion on the coarse levels only.
 LkParams LkParams::fast() {
   LkParams p;
   p.levels = 0;
-  p.iterations = 3;
+  p.coarsest_side = 20;
+  p.iterations = 5;
   p.robust_scale = 0.008;
-  p.level_median = 5;
-  p.final_median = 5;
-  p.search_radius = 12;
+  p.final_median = 3;
+  p.search_radius = 8;
+  p.fuse_far_step = 16;
+  p.fuse_far_finest_level = 3;
   p.fuse_step = 6;
-  p.fuse_finest_level = 2;
+  p.fuse_finest_level = 3;
   p.mask_outside = true;
-  p.finest_level = 1;
+  p.finest_level = 2;
   return p;
 }
 
@@ -88,10 +97,18 @@ void LkParams::validate() const {
     fail("search radius must be in 0.." + std::to_string(kMaxSearchRadius) + " (0 = off), got " +
          std::to_string(search_radius));
   }
-  if (fuse_step < 0 || fuse_step > 32) {
-    fail("fuse step must be in 0..32 (0 = off), got " + std::to_string(fuse_step));
+  if (coarsest_side < kMinLevelSide || coarsest_side > 480) {
+    fail("coarsest side must be in " + std::to_string(kMinLevelSide) + "..480 pixels, got " +
+         std::to_string(coarsest_side));
+  }
+  for (const auto& [name, step] :
+       {std::pair{"fuse step", fuse_step}, std::pair{"fuse far step", fuse_far_step}}) {
+    if (step < 0 || step > 32) {
+      fail(std::string(name) + " must be in 0..32 (0 = off), got " + std::to_string(step));
+    }
   }
   for (const auto& [name, level] : {std::pair{"fuse finest level", fuse_finest_level},
+                                    std::pair{"fuse far finest level", fuse_far_finest_level},
                                     std::pair{"finest level", finest_level}}) {
     if (level < 0 || level >= kMaxLevels) {
       fail(std::string(name) + " must be in 0.." + std::to_string(kMaxLevels - 1) + ", got " +

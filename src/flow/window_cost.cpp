@@ -3,43 +3,20 @@
 #include <algorithm>
 #include <cstddef>
 
+#include <opencv2/imgproc.hpp>
+
 #include "flow/lk_rows.hpp"
 
 namespace roiflow::flow::detail {
 
-BoxSum::BoxSum(int w, int h, int r) : w_(w), h_(h), r_(r), column_(w), padded_(w + 2 * r, 0.f) {}
+BoxSum::BoxSum(int w, int h, int r) : w_(w), h_(h), r_(r) {}
 
 void BoxSum::operator()(const float* src, float* dst) {
-  const int w = w_, h = h_, r = r_;
-  std::fill(column_.begin(), column_.end(), 0.f);
-  float* __restrict a = column_.data();
-  for (int y = 0; y < std::min(r, h); ++y) {
-    const float* __restrict in = src + static_cast<std::size_t>(y) * w;
-    for (int x = 0; x < w; ++x)
-      a[x] += in[x];
-  }
-  for (int y = 0; y < h; ++y) {
-    if (y + r < h) {
-      const float* __restrict in = src + static_cast<std::size_t>(y + r) * w;
-      for (int x = 0; x < w; ++x)
-        a[x] += in[x];
-    }
-    if (y - r - 1 >= 0) {
-      const float* __restrict out = src + static_cast<std::size_t>(y - r - 1) * w;
-      for (int x = 0; x < w; ++x)
-        a[x] -= out[x];
-    }
-    // Zeros on both sides of the row make the clipped window a plain sum of 2r + 1 taps.
-    float* __restrict p = padded_.data() + r;
-    std::copy_n(a, w, p);
-    float* __restrict o = dst + static_cast<std::size_t>(y) * w;
-    for (int x = 0; x < w; ++x) {
-      float s = 0.f;
-      for (int k = -r; k <= r; ++k)
-        s += p[x + k];
-      o[x] = s;
-    }
-  }
+  // OpenCV's box filter (running sums, vectorised); zeros outside make the clipped window.
+  const cv::Mat in(h_, w_, CV_32F, const_cast<float*>(src));
+  cv::Mat out(h_, w_, CV_32F, dst);
+  cv::boxFilter(in, out, CV_32F, cv::Size(2 * r_ + 1, 2 * r_ + 1), cv::Point(-1, -1), false,
+                cv::BORDER_CONSTANT);
 }
 
 ZssdWindow::ZssdWindow(int w, int h, int window)

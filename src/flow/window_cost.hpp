@@ -12,9 +12,7 @@
 
 namespace roiflow::flow::detail {
 
-// Sums of `src` (w x h, row-major) over (2r + 1)^2 windows clipped at the border, into `dst`:
-// running sums down the columns, then a direct sum of 2r + 1 taps along each row (which the
-// compiler vectorises; a running sum along the row would not be).
+// Sums of `src` (w x h, row-major) over (2r + 1)^2 windows clipped at the border, into `dst`.
 class BoxSum {
  public:
   BoxSum(int w, int h, int r);
@@ -22,7 +20,6 @@ class BoxSum {
 
  private:
   int w_, h_, r_;
-  std::vector<float> column_, padded_;  // running column sums; one row with r zeros each side
 };
 
 // Zero-mean SSD of each pixel's window from the differences d = I1(x + f) - I0(x):

@@ -109,6 +109,9 @@ TEST(DenseLkTest, RejectsEveryParameterOutOfRange) {
       {"expected motion", "-1", [](LkParams& p) { p.expected_motion = -1; }},
       {"search radius", "25", [](LkParams& p) { p.search_radius = 25; }},
       {"fuse step", "33", [](LkParams& p) { p.fuse_step = 33; }},
+      {"fuse far step", "-1", [](LkParams& p) { p.fuse_far_step = -1; }},
+      {"fuse far finest level", "6", [](LkParams& p) { p.fuse_far_finest_level = 6; }},
+      {"coarsest side", "11", [](LkParams& p) { p.coarsest_side = 11; }},
       {"fuse finest level", "6", [](LkParams& p) { p.fuse_finest_level = 6; }},
       {"finest level", "-1", [](LkParams& p) { p.finest_level = -1; }},
   };
