@@ -94,7 +94,14 @@ FlowFn roiflow_flow(const roiflow::flow::LkParams& params) {
 
 FlowFn dis_flow(int preset) {
   cv::Ptr<cv::DISOpticalFlow> dis = cv::DISOpticalFlow::create(preset);
-  return [dis](const Scene& s, cv::Mat& flow) { dis->calc(s.frame0, s.frame1, flow); };
+  return [dis](const Scene& s, cv::Mat& flow) {
+    // DIS takes a flow argument of the frames' size as its initial flow: handing it back the
+    // flow of the previous call on the same pair (as a timing loop does) would start it from a
+    // converged answer. A fresh output makes every call compute from scratch, as roiflow's do.
+    cv::Mat out;
+    dis->calc(s.frame0, s.frame1, out);
+    flow = out;
+  };
 }
 
 FlowFn farneback_flow() {
