@@ -1,0 +1,90 @@
+// The hand-vectorised kernels of dense LK (internal to roiflow::flow), compiled once per
+// instruction set and chosen at run time: lk_kernels() is the table of the best kind this CPU
+// runs (AVX-512, AVX2 + FMA, or the build's baseline: SSE2 on x86-64, NEON on arm64, plain C++
+// elsewhere). Everything crossing this boundary is a plain struct of numbers and pointers, so
+// that no inline function is compiled with two instruction sets.
+//
+//   const LkKernels& k = lk_kernels();
+//   k.run_band(job);   // the iterations of one level over rows [job.begin, job.end)
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+namespace roiflow::flow::detail {
+
+// Rows of a flow field (u, v planar): row r at u + ((r - first) & mask) * stride. A plane has
+// mask -1; a ring of 2^k rows has mask 2^k - 1. Every row holds w + 1 floats readable past the
+// computed width (the last column is replicated into column w) and is padded to LevelJob::wp.
+struct FlowRows {
+  float* u = nullptr;
+  float* v = nullptr;
+  std::ptrdiff_t stride = 0;
+  int mask = -1;
+  int first = 0;
+};
+
+// Rows an iteration computes in a row before the next iteration takes its turn.
+inline constexpr int kBatchRows = 8;
+
+// One level's problem, as the kernels see it.
+struct LevelJob {
+  const float* i0 = nullptr;                // frame t's level, whole image
+  const float* i1 = nullptr;                // frame t+1's level, whole image
+  std::ptrdiff_t i0_step = 0, i1_step = 0;  // in floats
+  int cols = 0, rows = 0;                   // level size
+  int x0 = 0, y0 = 0, w = 0, h = 0;         // the computed rectangle
+  int wp = 0;                               // padded length of every internal row
+  int derivative = 0;                       // 0 Horn–Schunck, 1 Scharr, 2 central
+  int lo = 0, hi = 0;                       // window offsets (see lk_level.hpp's Window)
+  bool half = false;                        // half-weight end taps
+  float lambda = 0.f;
+  float inv_s2 = 0.f;             // robust weights: 1 / scale^2, 0 = least squares
+  const float* inv_cx = nullptr;  // wp entries: 1 / horizontal window weight
+  const float* cy = nullptr;      // h entries: vertical window weight
+  int stripe = 16;                // rows between fresh window sums (a band starts on one)
+};
+
+// How far rows of one iteration reach into the previous one's: row y reads rows
+// y - reach_up .. y + reach_down.
+int reach_up(const LevelJob& level);
+int reach_down(const LevelJob& level);
+
+// The iterations of one level over the final rows [begin, end), each earlier iteration over the
+// rows the next one reads (rounded out to a stripe start, so that every row is computed exactly
+// as in a single pass over the level: the result never depends on how rows are split).
+struct BandJob {
+  const LevelJob* level = nullptr;
+  int iterations = 1;
+  int begin = 0, end = 0;
+  FlowRows input;                        // what iteration 0 reads
+  FlowRows output;                       // what the last iteration writes
+  float* confidence = nullptr;           // last iteration: per row, or null
+  std::ptrdiff_t confidence_stride = 0;  // floats, rows indexed from 0 like `output`
+  const FlowRows* rings = nullptr;       // iterations - 1 intermediate results
+  float* const* scratch = nullptr;  // per iteration: scratch_floats(level) floats, 64-byte aligned
+};
+
+// Rows [first, first + count) of the first iteration's rows needed for [begin, end).
+struct RowSpan {
+  int first = 0, count = 0;
+};
+
+struct LkKernels {
+  const char* name;  // "avx512", "avx2", "sse2", "neon" or "scalar"
+  int lanes;         // floats per vector
+  std::size_t (*scratch_floats)(const LevelJob& level);
+  void (*run_band)(const BandJob& job);
+  // The rows iteration 0 reads for final rows [begin, end).
+  RowSpan (*input_rows)(const LevelJob& level, int iterations, int begin, int end);
+};
+
+// The kernels of the best instruction set this CPU runs. ROIFLOW_SIMD=avx512|avx2|base in the
+// environment picks a lower one (for comparisons); an unavailable one is ignored.
+const LkKernels& lk_kernels();
+// Every kind built into this library that this CPU runs, best first.
+int available_lk_kernels(const LkKernels** out, int capacity);
+// Tests and benchmarks: use `kernels` from now on (nullptr: back to lk_kernels()'s choice).
+void set_lk_kernels_for_testing(const LkKernels* kernels);
+
+}  // namespace roiflow::flow::detail
