@@ -7,8 +7,8 @@
 #include <optional>
 #include <string>
 
+#include "core/error.hpp"
 #include "flow/dense_lk.hpp"
-#include "flow/error.hpp"
 #include "flow/metrics.hpp"
 
 namespace roiflow::cli {

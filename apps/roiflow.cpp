@@ -26,19 +26,19 @@
 #include <vector>
 
 #include "cli_common.hpp"
+#include "core/atomic_write.hpp"
+#include "core/error.hpp"
+#include "eval/flo_io.hpp"
+#include "eval/flow_eval.hpp"
+#include "eval/otb_score.hpp"
+#include "eval/synthetic.hpp"
+#include "eval/track_log.hpp"
 #include "flow/color_code.hpp"
 #include "flow/dense_lk.hpp"
-#include "flow/error.hpp"
-#include "flow/flo_io.hpp"
 #include "flow/metrics.hpp"
 #include "flow/pyramid.hpp"
-#include "flow/synthetic.hpp"
 #include "pipeline/tbb_executor.hpp"
-#include "stages/atomic_write.hpp"
-#include "stages/flow_eval.hpp"
-#include "stages/html_report.hpp"
-#include "stages/otb_score.hpp"
-#include "stages/track_log.hpp"
+#include "report/html_report.hpp"
 #include "stages/video_source.hpp"
 
 namespace {
@@ -47,9 +47,9 @@ using namespace roiflow;
 using namespace roiflow::cli;
 
 const cv::Size kSyntheticSize{640, 480};
-constexpr flow::SceneKind kSceneKinds[] = {flow::SceneKind::Translation, flow::SceneKind::Rotation,
-                                           flow::SceneKind::Zoom, flow::SceneKind::NonRigid,
-                                           flow::SceneKind::MovingObject};
+constexpr eval::SceneKind kSceneKinds[] = {eval::SceneKind::Translation, eval::SceneKind::Rotation,
+                                           eval::SceneKind::Zoom, eval::SceneKind::NonRigid,
+                                           eval::SceneKind::MovingObject};
 
 // ---------------------------------------------------------------------------------------------
 // roiflow flow
@@ -65,9 +65,9 @@ struct FlowCommand {
   std::string ground_truth;
 };
 
-flow::SceneKind scene_kind(const std::string& name) {
-  for (flow::SceneKind kind : kSceneKinds) {
-    if (name == flow::to_string(kind)) return kind;
+eval::SceneKind scene_kind(const std::string& name) {
+  for (eval::SceneKind kind : kSceneKinds) {
+    if (name == eval::to_string(kind)) return kind;
   }
   throw UsageError("unknown synthetic scene '" + name + "'");
 }
@@ -91,7 +91,7 @@ void run_flow(const FlowCommand& cmd) {
   cv::Mat frame0, frame1, truth;
   std::string source;
   if (synthetic) {
-    flow::Scene scene = flow::make_scene(scene_kind(cmd.scene), kSyntheticSize);
+    eval::Scene scene = eval::make_scene(scene_kind(cmd.scene), kSyntheticSize);
     frame0 = scene.frame0;
     frame1 = scene.frame1;
     truth = scene.flow;
@@ -102,16 +102,16 @@ void run_flow(const FlowCommand& cmd) {
       if (std::filesystem::is_directory(image, ec))
         throw Error("image '" + image + "' is a directory, not an image file");
     }
-    frame0 = stages::read_gray(cmd.frame0);
-    stages::check_frame_size(frame0.size(), "image '" + cmd.frame0 + "'");
-    frame1 = stages::read_gray(cmd.frame1);
-    stages::check_frame_size(frame1.size(), "image '" + cmd.frame1 + "'");
+    frame0 = eval::read_gray(cmd.frame0);
+    eval::check_frame_size(frame0.size(), "image '" + cmd.frame0 + "'");
+    frame1 = eval::read_gray(cmd.frame1);
+    eval::check_frame_size(frame1.size(), "image '" + cmd.frame1 + "'");
     if (frame0.size() != frame1.size()) {
       throw Error("'" + cmd.frame0 + "' is " + size_string(frame0.size()) + " but '" + cmd.frame1 +
                   "' is " + size_string(frame1.size()));
     }
     if (!cmd.ground_truth.empty()) {
-      truth = flow::read_flo(cmd.ground_truth);
+      truth = eval::read_flo(cmd.ground_truth);
       if (truth.size() != frame0.size()) {
         throw Error("--gt: '" + cmd.ground_truth + "' is " + size_string(truth.size()) + " but '" +
                     cmd.frame0 + "' is " + size_string(frame0.size()));
@@ -135,13 +135,13 @@ void run_flow(const FlowCommand& cmd) {
   }
 
   std::string written = cmd.output;
-  flow::write_flo(cmd.output, result.flow);
+  eval::write_flo(cmd.output, result.flow);
   if (!cmd.color.empty()) {
-    stages::write_image_atomically(cmd.color, flow::flow_to_color(result.flow));
+    eval::write_image_atomically(cmd.color, flow::flow_to_color(result.flow));
     written += ", " + cmd.color;
   }
   if (!cmd.legend.empty()) {
-    stages::write_image_atomically(cmd.legend, flow::color_wheel_legend());
+    eval::write_image_atomically(cmd.legend, flow::color_wheel_legend());
     written += ", " + cmd.legend;
   }
 
@@ -156,14 +156,14 @@ void add_flow_command(CLI::App& app, FlowCommand& cmd) {
   sub->add_option("A", cmd.frame0, "frame t (read as 8-bit gray)")->type_name("IMAGE");
   sub->add_option("B", cmd.frame1, "frame t+1")->type_name("IMAGE");
   std::vector<std::string> scenes;
-  for (flow::SceneKind kind : kSceneKinds)
-    scenes.emplace_back(flow::to_string(kind));
+  for (eval::SceneKind kind : kSceneKinds)
+    scenes.emplace_back(eval::to_string(kind));
   sub->add_option("--synthetic", cmd.scene,
                   "use a built-in " + size_string(kSyntheticSize) +
                       " pair with exact ground truth instead of A B, and print the error")
       ->type_name("SCENE")
       ->expected(0, 1)
-      ->default_str(flow::to_string(flow::SceneKind::MovingObject))
+      ->default_str(eval::to_string(eval::SceneKind::MovingObject))
       ->check(CLI::IsMember(scenes));
   sub->add_option("-o,--output", cmd.output, "the flow, Middlebury .flo")
       ->type_name("FLO")
@@ -193,25 +193,25 @@ struct EvalCommand {
   std::string report;
 };
 
-std::vector<stages::EvalPair> eval_pairs(const EvalCommand& cmd) {
+std::vector<eval::EvalPair> eval_pairs(const EvalCommand& cmd) {
   if (cmd.dir.empty() && cmd.pairs.empty()) {
     throw UsageError(
         "eval needs a Middlebury, Sintel or KITTI directory DIR or at least one --pair A B GT");
   }
   if (!cmd.dir.empty()) {
-    stages::FindOptions options;
-    options.layout = stages::parse_layout(cmd.layout);
+    eval::FindOptions options;
+    options.layout = eval::parse_layout(cmd.layout);
     options.pass = cmd.pass;
     options.scene = cmd.scene;
     options.max_pairs = cmd.max_pairs;
-    return stages::find_pairs(cmd.dir, options);
+    return eval::find_pairs(cmd.dir, options);
   }
   if (!cmd.exclude_masks.empty() && cmd.exclude_masks.size() != cmd.pairs.size()) {
     throw UsageError("--exclude-mask: got " + std::to_string(cmd.exclude_masks.size()) +
                      " masks for " + std::to_string(cmd.pairs.size()) +
                      " pairs (give one per --pair, in the same order)");
   }
-  std::vector<stages::EvalPair> pairs;
+  std::vector<eval::EvalPair> pairs;
   for (std::size_t i = 0; i < cmd.pairs.size(); ++i) {
     const std::vector<std::string>& p = cmd.pairs[i];
     pairs.push_back({"pair" + std::to_string(i + 1), p.at(0), p.at(1), p.at(2),
@@ -224,36 +224,36 @@ void run_eval(const EvalCommand& cmd) {
   const flow::LkParams params = lk_params(cmd.lk);
   if (!cmd.output.empty()) check_output_path(cmd.output, "-o");
   if (!cmd.report.empty()) check_output_path(cmd.report, "--report");
-  const std::vector<stages::EvalPair> pairs = eval_pairs(cmd);
+  const std::vector<eval::EvalPair> pairs = eval_pairs(cmd);
 
-  std::optional<stages::HtmlReport> report;
+  std::optional<report::HtmlReport> report;
   if (!cmd.report.empty()) {
     report.emplace("roiflow eval " + (cmd.dir.empty() ? std::string("--pair") : cmd.dir),
                    cmd.lk.preset, params);
   }
   const pipeline::TbbExecutor executor;
-  std::vector<stages::EvalRow> rows;
+  std::vector<eval::EvalRow> rows;
   pipeline::run_with_threads(cmd.lk.threads, [&] {
-    for (const stages::EvalPair& pair : pairs) {
-      stages::EvalImages images;
-      rows.push_back(stages::evaluate_pair(pair, params, &executor, report ? &images : nullptr));
+    for (const eval::EvalPair& pair : pairs) {
+      eval::EvalImages images;
+      rows.push_back(eval::evaluate_pair(pair, params, &executor, report ? &images : nullptr));
       if (report) report->add(rows.back(), images);
     }
   });
 
   std::string text;
   if (cmd.format == "csv") {
-    text = stages::format_csv(rows);
+    text = eval::format_csv(rows);
   } else if (cmd.format == "json") {
-    text = stages::format_json(rows, cmd.lk.preset, params);
+    text = eval::format_json(rows, cmd.lk.preset, params);
   } else {
-    text = stages::format_table(rows);
+    text = eval::format_table(rows);
   }
   if (report) report->write(cmd.report);
   if (cmd.output.empty()) {
     std::cout << text;
   } else {
-    stages::write_text_atomically(cmd.output, text);
+    write_text_atomically(cmd.output, text);
     std::cout << "evaluated " << rows.size() << " pairs, wrote " << cmd.output << "\n";
   }
   if (report) std::cout << "wrote report " << cmd.report << "\n";
@@ -324,16 +324,16 @@ struct ScoreCommand {
 };
 
 void run_score(const ScoreCommand& cmd) {
-  const std::vector<stages::TrackRecord> records = stages::read_track_csv(cmd.track);
+  const std::vector<eval::TrackRecord> records = eval::read_track_csv(cmd.track);
   std::vector<cv::Rect2f> track;
   try {
-    track = stages::track_boxes(records);
+    track = eval::track_boxes(records);
   } catch (const Error& e) {
     // track_boxes knows records, not the file they came from.
     throw Error("track log '" + cmd.track + "': " + e.what());
   }
-  const std::vector<cv::Rect2f> truth = stages::read_ground_truth(cmd.ground_truth);
-  const stages::OtbScore s = stages::score(track, truth);
+  const std::vector<cv::Rect2f> truth = eval::read_ground_truth(cmd.ground_truth);
+  const eval::OtbScore s = eval::score(track, truth);
 
   if (cmd.format == "json") {
     const nlohmann::ordered_json doc = {{"auc", s.auc},
@@ -380,7 +380,7 @@ std::string one_line(std::string text) {
   return text;
 }
 
-int report(const std::string& message, int exit_code) {
+int report_error(const std::string& message, int exit_code) {
   std::cerr << "roiflow: error: " << one_line(message) << "\n";
   return exit_code;
 }
@@ -390,7 +390,7 @@ int report_usage(const CLI::App& app, const std::string& message) {
   std::string command = "roiflow";
   for (const CLI::App* sub : app.get_subcommands())
     command += " " + sub->get_name();
-  return report(message + " (see '" + command + " --help')", 2);
+  return report_error(message + " (see '" + command + " --help')", 2);
 }
 
 }  // namespace
@@ -422,11 +422,11 @@ int main(int argc, char** argv) {
   } catch (const UsageError& e) {
     return report_usage(app, e.what());
   } catch (const cv::Exception& e) {
-    return report("OpenCV: " + e.err, 1);
+    return report_error("OpenCV: " + e.err, 1);
   } catch (const std::exception& e) {
-    return report(e.what(), 1);
+    return report_error(e.what(), 1);
   } catch (...) {
-    return report("unexpected failure", 1);
+    return report_error("unexpected failure", 1);
   }
   return exit_code;
 }

@@ -11,11 +11,11 @@
 #include <vector>
 
 #include "cli_common.hpp"
+#include "core/atomic_write.hpp"
+#include "eval/flow_eval.hpp"
+#include "eval/sweep.hpp"
 #include "pipeline/tbb_executor.hpp"
-#include "stages/atomic_write.hpp"
-#include "stages/flow_eval.hpp"
-#include "stages/plot.hpp"
-#include "stages/sweep.hpp"
+#include "report/sweep_plot.hpp"
 
 namespace roiflow::cli {
 namespace {
@@ -34,17 +34,17 @@ struct SweepCommand {
   bool progress = true;
 };
 
-std::vector<stages::EvalPair> sweep_pairs(const SweepCommand& cmd) {
+std::vector<eval::EvalPair> sweep_pairs(const SweepCommand& cmd) {
   if (cmd.dir.empty() && cmd.pairs.empty()) {
     throw UsageError("sweep needs a Middlebury directory DIR or at least one --pair A B GT");
   }
-  std::vector<stages::EvalPair> pairs;
+  std::vector<eval::EvalPair> pairs;
   if (!cmd.dir.empty()) {
-    pairs = stages::find_middlebury(cmd.dir);
+    pairs = eval::find_middlebury(cmd.dir);
   } else {
     for (std::size_t i = 0; i < cmd.pairs.size(); ++i) {
       const std::vector<std::string>& p = cmd.pairs[i];
-      stages::EvalPair pair;
+      eval::EvalPair pair;
       pair.name = "pair" + std::to_string(i + 1);
       pair.frame0 = p.at(0);
       pair.frame1 = p.at(1);
@@ -80,61 +80,61 @@ std::string subtitle(const SweepCommand& cmd) {
 
 void run_sweep(const SweepCommand& cmd) {
   const flow::LkParams base = lk_params(cmd.lk);
-  std::vector<stages::SweepParam> params;
+  std::vector<eval::SweepParam> params;
   if (cmd.param == "all") {
     if (!cmd.values.empty()) throw UsageError("--values needs one --param, not all");
-    params = stages::all_sweep_params();
+    params = eval::all_sweep_params();
   } else {
-    params.push_back(stages::sweep_param_from_string(cmd.param));
+    params.push_back(eval::sweep_param_from_string(cmd.param));
   }
   // Every value is checked before the first pair is read.
   std::vector<std::vector<double>> values;
-  for (stages::SweepParam p : params) {
-    values.push_back(cmd.values.empty() ? stages::default_sweep_values(p, base) : cmd.values);
+  for (eval::SweepParam p : params) {
+    values.push_back(cmd.values.empty() ? eval::default_sweep_values(p, base) : cmd.values);
     for (double v : values.back()) {
       try {
-        stages::with_value(base, p, v);
+        eval::with_value(base, p, v);
       } catch (const Error& e) {
         throw UsageError(std::string("--values: ") + e.what());
       }
     }
   }
-  const std::vector<stages::EvalPair> pairs = sweep_pairs(cmd);
+  const std::vector<eval::EvalPair> pairs = sweep_pairs(cmd);
   prepare_out_dir(cmd.out);
   const std::string csv_path = (fs::path(cmd.out) / "sweep.csv").string();
 
   const pipeline::TbbExecutor executor;
-  std::vector<stages::SweepRow> rows;
+  std::vector<eval::SweepRow> rows;
   std::vector<std::string> written;
   const std::string sub = subtitle(cmd);
   pipeline::run_with_threads(cmd.lk.threads, [&] {
     for (std::size_t k = 0; k < params.size(); ++k) {
-      const stages::SweepParam p = params[k];
+      const eval::SweepParam p = params[k];
       const std::size_t n = values[k].size();
-      const auto progress = [&](const stages::SweepRow& r, std::size_t i) {
+      const auto progress = [&](const eval::SweepRow& r, std::size_t i) {
         if (!cmd.progress) return;
-        std::cerr << "sweep " << stages::to_string(p) << " " << stages::sweep_value_text(r.value)
+        std::cerr << "sweep " << eval::to_string(p) << " " << eval::sweep_value_text(r.value)
                   << " (" << i + 1 << "/" << n << "): AAE " << fixed(r.aae_deg, 3) << " deg, EPE "
                   << fixed(r.epe, 4) << " px, " << fixed(r.ms_per_pair, 2) << " ms/pair"
                   << std::endl;
       };
-      const std::vector<stages::SweepRow> part =
-          stages::sweep(pairs, base, p, values[k], &executor, progress, cmd.repeats);
+      const std::vector<eval::SweepRow> part =
+          eval::sweep(pairs, base, p, values[k], &executor, progress, cmd.repeats);
       rows.insert(rows.end(), part.begin(), part.end());
       // Written after each parameter, so an interrupted "all" keeps what is complete.
-      stages::write_text_atomically(csv_path, stages::sweep_csv(rows));
+      write_text_atomically(csv_path, eval::sweep_csv(rows));
       const std::string svg =
-          (fs::path(cmd.out) / (std::string(stages::to_string(p)) + ".svg")).string();
-      stages::write_plot_svg(svg, stages::sweep_plot(p, rows, sub));
+          (fs::path(cmd.out) / (std::string(eval::to_string(p)) + ".svg")).string();
+      report::write_plot_svg(svg, report::sweep_plot(p, rows, sub));
       written.push_back(svg);
     }
   });
 
   std::cout << "parameter    value      AAE(deg)    EPE(px)  ms/pair\n";
-  for (const stages::SweepRow& r : rows) {
+  for (const eval::SweepRow& r : rows) {
     char line[128];
-    std::snprintf(line, sizeof line, "%-11s %-9s %9.3f %10.4f %8.2f\n", stages::to_string(r.param),
-                  stages::sweep_value_text(r.value).c_str(), r.aae_deg, r.epe, r.ms_per_pair);
+    std::snprintf(line, sizeof line, "%-11s %-9s %9.3f %10.4f %8.2f\n", eval::to_string(r.param),
+                  eval::sweep_value_text(r.value).c_str(), r.aae_deg, r.epe, r.ms_per_pair);
     std::cout << line;
   }
   std::string list = csv_path;

@@ -23,17 +23,18 @@
 #include <vector>
 
 #include "cli_common.hpp"
+#include "core/atomic_write.hpp"
+#include "eval/otb_score.hpp"
+#include "eval/track_log.hpp"
+#include "eval/tracking_scene.hpp"
 #include "flow/color_code.hpp"
-#include "flow/tracking_scene.hpp"
 #include "pipeline/frame_graph.hpp"
 #include "pipeline/tbb_executor.hpp"
-#include "stages/annotate.hpp"
-#include "stages/atomic_write.hpp"
-#include "stages/otb_score.hpp"
-#include "stages/plot.hpp"
-#include "stages/progress.hpp"
-#include "stages/run_stats.hpp"
-#include "stages/track_log.hpp"
+#include "report/annotate.hpp"
+#include "report/plot.hpp"
+#include "report/progress.hpp"
+#include "report/run_stats.hpp"
+#include "stages/track_log_sink.hpp"
 #include "stages/tracker.hpp"
 #include "stages/video_sink.hpp"
 #include "stages/video_source.hpp"
@@ -168,6 +169,19 @@ Ending ending(const pipeline::RunReport& report, const stages::SourceStatus* sta
 // ---------------------------------------------------------------------------------------------
 // roiflow track
 
+report::TrackAnnotation annotation(const stages::TrackerOutput& out) {
+  report::TrackAnnotation a;
+  a.index = out.index;
+  a.has_target = out.has_target;
+  a.box = out.box;
+  a.velocity = out.velocity;
+  a.global = out.mode == eval::TrackRecord::Mode::Global;
+  a.lost = out.lost;
+  a.region = out.region;
+  a.region_flow = out.region_flow;
+  return a;
+}
+
 // What to read of the input and how far ahead (track and dense).
 struct SourceOptions {
   long long start = 0;
@@ -205,7 +219,7 @@ struct TrackCommand {
 struct TrackRun {
   pipeline::RunReport report;
   nlohmann::ordered_json summary;
-  std::vector<stages::TrackRecord> records;  // kept when asked (the demo scores them)
+  std::vector<eval::TrackRecord> records;  // kept when asked (the demo scores them)
 };
 
 // Runs the tracker over `source` with the sinks the options ask for.
@@ -218,27 +232,28 @@ TrackRun track(const pipeline::FrameSource& source, cv::Size size, double fps, l
   if (!log_path.empty()) log.emplace(log_path);
   std::optional<stages::VideoSink> video;
   if (!out.video.empty()) video.emplace(out.video, fps, size);
-  stages::Progress progress(std::cerr, frame_hint,
-                            out.progress && stages::Progress::stderr_is_terminal());
+  report::Progress progress(std::cerr, frame_hint,
+                            out.progress && report::Progress::stderr_is_terminal());
 
   TrackRun run;
   long long lost = 0;
   std::vector<pipeline::TrackSink> sinks;
   sinks.push_back({"log", [&](const pipeline::TrackedFrame& f) {
-                     const stages::TrackRecord r = f.output->record();
+                     const eval::TrackRecord r = f.output->record();
                      if (r.lost) ++lost;
                      if (log) log->write(r);
                      if (keep_records) run.records.push_back(r);
                    }});
   if (video) {
     sinks.push_back({"video", [&](const pipeline::TrackedFrame& f) {
-                       video->write(stages::annotate_frame(f.frame->picture(), *f.output));
+                       video->write(
+                           report::annotate_frame(f.frame->picture(), annotation(*f.output)));
                      }});
   }
   sinks.push_back(
       {"progress", [&](const pipeline::TrackedFrame& f) { progress.update(f.seq + 1); }});
 
-  stages::RunStats stats;
+  report::RunStats stats;
   pipeline::GraphOptions options;
   options.threads = threads;
   options.max_in_flight = in_flight;
@@ -264,7 +279,7 @@ TrackRun track(const pipeline::FrameSource& source, cv::Size size, double fps, l
       {"threads", threads},
       {"roi", params.roi},
       {"max_in_flight", run.report.max_in_flight},
-      {"peak_rss_mb", stages::peak_rss_mb()},
+      {"peak_rss_mb", report::peak_rss_mb()},
       {"stages", s.at("stages")}};
   return run;
 }
@@ -439,7 +454,7 @@ CompareRun compare_run(const TrackCommand& cmd, const std::string& mode, int pat
   const std::string log = (log_dir / (stem + ".csv")).string();
   const std::string summary = (log_dir / (stem + ".json")).string();
   const std::string err = (temp_dir / (stem + ".err")).string();
-  if (stages::Progress::stderr_is_terminal() && cmd.out.progress) {
+  if (report::Progress::stderr_is_terminal() && cmd.out.progress) {
     std::cerr << "compare: " << mode << " mode, patch " << patch << " ..." << std::endl;
   }
   const int code = run_child(child_args(cmd, mode, patch, log, summary), err);
@@ -460,7 +475,7 @@ CompareRun compare_run(const TrackCommand& cmd, const std::string& mode, int pat
     throw Error("--compare: cannot read the " + mode + " run's summary '" + summary +
                 "': " + e.what());
   }
-  for (const stages::TrackRecord& r : stages::read_track_csv(log))
+  for (const eval::TrackRecord& r : eval::read_track_csv(log))
     run.ms.push_back(r.ms);
   if (run.ms.empty()) throw Error("--compare: the " + mode + " run tracked no frame");
   std::vector<double> sorted = run.ms;
@@ -599,22 +614,22 @@ int run_compare(const TrackCommand& cmd) {
   std::vector<std::string> written;
   const auto write_text = [&](const std::string& name, const std::string& text) {
     const std::string path = (out_dir / name).string();
-    stages::write_text_atomically(path, text);
+    write_text_atomically(path, text);
     written.push_back(path);
   };
   write_text("compare.csv", csv);
   write_text("compare.json", doc.dump(2) + "\n");
 
-  stages::Plot frames_plot;
+  report::Plot frames_plot;
   frames_plot.title = "Tracker time per frame, local vs global (" +
                       fs::path(cmd.input).filename().string() + ", patch " + std::to_string(patch) +
                       ")";
   frames_plot.x_label = "frame index";
-  stages::PlotPanel& frames_panel = frames_plot.panels.emplace_back();
+  report::PlotPanel& frames_panel = frames_plot.panels.emplace_back();
   frames_panel.y_label = "tracker time (ms per frame)";
   frames_panel.y_from_zero = true;
   for (const CompareRun* r : {&local, &global}) {
-    stages::PlotSeries s;
+    report::PlotSeries s;
     s.name = r->mode + " (median " + fixed(r->ms_median, 2) + " ms)";
     for (std::size_t i = 0; i < r->ms.size(); ++i) {
       s.x.push_back(static_cast<double>(cmd.source.start + static_cast<long long>(i) + 1));
@@ -624,22 +639,22 @@ int run_compare(const TrackCommand& cmd) {
     frames_panel.series.push_back(std::move(s));
   }
   const std::string frames_svg = (out_dir / "ms_per_frame.svg").string();
-  stages::write_plot_svg(frames_svg, frames_plot);
+  report::write_plot_svg(frames_svg, frames_plot);
   written.push_back(frames_svg);
 
   if (!patch_runs.empty()) {
-    stages::Plot plot;
+    report::Plot plot;
     plot.title = "Tracker time vs patch size, local vs global (" +
                  fs::path(cmd.input).filename().string() + ")";
     plot.x_label = "patch size (px)";
     plot.panels.resize(2);  // references taken after the last resize stay valid
-    stages::PlotPanel& time = plot.panels[0];
+    report::PlotPanel& time = plot.panels[0];
     time.y_label = "tracker time (ms per frame, median)";
     time.y_from_zero = true;
-    stages::PlotPanel& ratio = plot.panels[1];
+    report::PlotPanel& ratio = plot.panels[1];
     ratio.y_label = "global / local time (x)";
     ratio.y_from_zero = true;
-    stages::PlotSeries l{"local", {}, {}}, g{"global", {}, {}}, r{"speed-up of local", {}, {}};
+    report::PlotSeries l{"local", {}, {}}, g{"global", {}, {}}, r{"speed-up of local", {}, {}};
     for (const auto& [lr, gr] : patch_runs) {
       l.x.push_back(lr.patch);
       l.y.push_back(lr.ms_median);
@@ -651,7 +666,7 @@ int run_compare(const TrackCommand& cmd) {
     time.series = {l, g};
     ratio.series = {r};
     const std::string path = (out_dir / "patches.svg").string();
-    stages::write_plot_svg(path, plot);
+    report::write_plot_svg(path, plot);
     written.push_back(path);
   }
 
@@ -715,7 +730,7 @@ int run_track(const TrackCommand& cmd) {
   if (!cmd.log.empty()) written.push_back(cmd.log);
   if (!cmd.out.video.empty()) written.push_back(cmd.out.video);
   if (!cmd.out.summary.empty()) {
-    stages::write_text_atomically(cmd.out.summary, run.summary.dump(2) + "\n");
+    write_text_atomically(cmd.out.summary, run.summary.dump(2) + "\n");
     written.push_back(cmd.out.summary);
   }
   print_track_summary("track " + source.description(), run.summary, written);
@@ -819,11 +834,11 @@ int run_dense(const DenseCommand& cmd) {
   stages::VideoSource source(cmd.input, cmd.source.params());
   stages::VideoSink video(cmd.out.video, source.fps(), source.size());
   const long long hint = source.frame_count_hint();
-  stages::Progress progress(std::cerr, hint > 1 ? hint - 1 : hint,
-                            cmd.out.progress && stages::Progress::stderr_is_terminal());
+  report::Progress progress(std::cerr, hint > 1 ? hint - 1 : hint,
+                            cmd.out.progress && report::Progress::stderr_is_terminal());
 
   SignalScope signals;
-  stages::RunStats stats;
+  report::RunStats stats;
   pipeline::GraphOptions options;
   options.threads = cmd.lk.threads;
   options.max_in_flight = cmd.source.in_flight;
@@ -856,11 +871,11 @@ int run_dense(const DenseCommand& cmd) {
       {"threads", cmd.lk.threads},
       {"preset", cmd.lk.preset},
       {"status", end.message.empty() ? source.status().message : end.message},
-      {"peak_rss_mb", stages::peak_rss_mb()},
+      {"peak_rss_mb", report::peak_rss_mb()},
       {"stages", s.at("stages")}};
   std::string written = cmd.out.video;
   if (!cmd.out.summary.empty()) {
-    stages::write_text_atomically(cmd.out.summary, summary.dump(2) + "\n");
+    write_text_atomically(cmd.out.summary, summary.dump(2) + "\n");
     written += ", " + cmd.out.summary;
   }
   std::cout << "dense " << source.description() << ": " << pairs << " pairs in "
@@ -898,9 +913,9 @@ struct DemoCommand {
 
 int run_demo(const DemoCommand& cmd) {
   fs::create_directories(cmd.dir);
-  flow::TrackingSceneParams scene_params;
+  eval::TrackingSceneParams scene_params;
   scene_params.frames = cmd.frames;
-  const flow::TrackingScene scene(scene_params);
+  const eval::TrackingScene scene(scene_params);
   const auto scene_source = [&scene]() {
     return [&scene, next = 0]() mutable -> std::optional<stages::Frame> {
       if (next >= scene.frames()) return std::nullopt;
@@ -942,14 +957,14 @@ int run_demo(const DemoCommand& cmd) {
                           "", RunOutputs{"", "", false}, false);
 
   std::vector<cv::Rect2f> boxes;
-  for (const stages::TrackRecord& r : local.records)
+  for (const eval::TrackRecord& r : local.records)
     boxes.push_back(r.box);
-  const stages::OtbScore s = stages::score(boxes, truth);
+  const eval::OtbScore s = eval::score(boxes, truth);
   double centre_error = 0;
   int found_at = -1;
   for (std::size_t i = 0; i < boxes.size(); ++i) {
     if (found_at < 0 && boxes[i].area() > 0) found_at = static_cast<int>(i);
-    if (found_at >= 0) centre_error += stages::center_error(boxes[i], truth[i]);
+    if (found_at >= 0) centre_error += eval::center_error(boxes[i], truth[i]);
   }
   const long long tracked = found_at < 0 ? 0 : static_cast<long long>(boxes.size()) - found_at;
   if (tracked > 0) centre_error /= static_cast<double>(tracked);
@@ -963,8 +978,8 @@ int run_demo(const DemoCommand& cmd) {
                             {"first_detection_frame", found_at + 1}};
   local.summary["global_mode"] = {{"tracker_fps", global.summary.at("tracker_fps")},
                                   {"fps", global.summary.at("fps")}};
-  stages::write_text_atomically(summary_path, local.summary.dump(2) + "\n");
-  stages::write_text_atomically(truth_path, truth_text);
+  write_text_atomically(summary_path, local.summary.dump(2) + "\n");
+  write_text_atomically(truth_path, truth_text);
 
   const double local_fps = local.summary.at("tracker_fps").get<double>();
   const double global_fps = global.summary.at("tracker_fps").get<double>();

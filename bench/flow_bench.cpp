@@ -31,17 +31,17 @@
 #include <utility>
 #include <vector>
 
+#include "eval/flo_io.hpp"
+#include "eval/flow_eval.hpp"
+#include "eval/synthetic.hpp"
 #include "flow/dense_lk.hpp"
-#include "flow/flo_io.hpp"
 #include "flow/metrics.hpp"
 #include "flow/pyramid.hpp"
-#include "flow/synthetic.hpp"
 #include "pipeline/tbb_executor.hpp"
-#include "stages/flow_eval.hpp"
 
 namespace {
 
-using roiflow::flow::Scene;
+using roiflow::eval::Scene;
 
 constexpr std::uint64_t kSeed = 1;
 const cv::Size kSizes[] = {{640, 480}, {1280, 720}};
@@ -52,7 +52,7 @@ const Scene& scene_of(cv::Size size) {
   static std::map<std::pair<int, int>, Scene> scenes;
   auto [it, inserted] = scenes.try_emplace({size.width, size.height});
   if (inserted)
-    it->second = roiflow::flow::make_scene(roiflow::flow::SceneKind::MovingObject, size, kSeed);
+    it->second = roiflow::eval::make_scene(roiflow::eval::SceneKind::MovingObject, size, kSeed);
   return it->second;
 }
 
@@ -165,10 +165,9 @@ void bm_pretreatment(benchmark::State& state, cv::Size size, bool opencv) {
 // Real data with ground truth: the Middlebury pairs as scenes (frames, ground-truth flow).
 std::vector<Scene> middlebury_scenes(const std::string& dir) {
   std::vector<Scene> scenes;
-  for (const roiflow::stages::EvalPair& pair : roiflow::stages::find_middlebury(dir)) {
-    scenes.push_back({roiflow::stages::read_gray(pair.frame0),
-                      roiflow::stages::read_gray(pair.frame1),
-                      roiflow::flow::read_flo(pair.ground_truth)});
+  for (const roiflow::eval::EvalPair& pair : roiflow::eval::find_middlebury(dir)) {
+    scenes.push_back({roiflow::eval::read_gray(pair.frame0), roiflow::eval::read_gray(pair.frame1),
+                      roiflow::eval::read_flo(pair.ground_truth)});
   }
   return scenes;
 }

@@ -58,10 +58,10 @@
 #include <string>
 #include <vector>
 
-#include "flow/tracking_scene.hpp"
+#include "eval/tracking_scene.hpp"
 #include "pipeline/frame_graph.hpp"
 #include "pipeline/tbb_executor.hpp"
-#include "stages/run_stats.hpp"
+#include "report/run_stats.hpp"
 #include "stages/tracker.hpp"
 #include "stages/video_sink.hpp"
 #include "stages/video_source.hpp"
@@ -76,9 +76,9 @@ constexpr int kThreadCounts[] = {1, 2};
 std::string synthetic_video() {
   const fs::path path = fs::temp_directory_path() / "roiflow_bench_synthetic640x480.mp4";
   if (!fs::exists(path)) {
-    flow::TrackingSceneParams params;
+    eval::TrackingSceneParams params;
     params.frames = 300;
-    const flow::TrackingScene scene(params);
+    const eval::TrackingScene scene(params);
     stages::VideoSink sink(path.string(), 25.0, scene.size());
     for (int i = 0; i < scene.frames(); ++i)
       sink.write(scene.render(i));
@@ -154,7 +154,7 @@ long long decode_all_opencv(const std::string& path) {
 
 // One tracking run of the file (default params but `mode`), no sinks; `stats` may be null.
 pipeline::RunReport track_all(const std::string& path, stages::TrackMode mode, int threads,
-                              stages::RunStats* stats, long long* activations = nullptr) {
+                              report::RunStats* stats, long long* activations = nullptr) {
   stages::VideoSource source(path, as_the_cli());
   pipeline::TbbExecutor tiles;
   stages::TrackerParams params;
@@ -184,7 +184,7 @@ void bm_track(benchmark::State& state, const std::string& path, stages::TrackMod
   double tracker_ms = 0;
   long long activations = 0;
   for (auto _ : state) {
-    stages::RunStats stats;
+    report::RunStats stats;
     const pipeline::RunReport report = track_all(path, mode, threads, &stats, &activations);
     frames += report.frames;
     const auto json = stats.to_json(report.wall_s);
@@ -305,7 +305,7 @@ void bm_tracker_only(benchmark::State& state, const std::string& path) {
       const stages::TrackerOutput out =
           tracker.process({f.index, f.image, f.gray, nullptr, f.deferred_image});
       total_ms += out.ms;
-      if (out.mode == stages::TrackRecord::Mode::Local && !out.lost) {
+      if (out.mode == eval::TrackRecord::Mode::Local && !out.lost) {
         local_ms += out.ms;
         ++local_frames;
       }

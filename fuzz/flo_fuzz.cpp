@@ -1,4 +1,4 @@
-// libFuzzer target: the Middlebury .flo reader (flow::parse_flo, which read_flo uses).
+// libFuzzer target: the Middlebury .flo reader (eval::parse_flo, which read_flo uses).
 #include <cstddef>
 #include <cstdint>
 #include <string_view>

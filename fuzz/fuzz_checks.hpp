@@ -1,5 +1,5 @@
-// What every fuzz target checks, shared with tests/fuzz_regression_test.cpp so that a saved crash
-// input is replayed through exactly the same code in the normal build.
+// What every fuzz target checks, shared with tests/eval/fuzz_regression_test.cpp so that a saved
+// crash input is replayed through exactly the same code in the normal build.
 //
 //   roiflow::fuzz::check_flo(bytes);   // throws InvariantBroken on a bug, nothing otherwise
 //
@@ -20,11 +20,11 @@
 #include <string_view>
 #include <vector>
 
-#include "flow/error.hpp"
-#include "flow/flo_io.hpp"
-#include "stages/kitti_flow.hpp"
-#include "stages/otb_score.hpp"
-#include "stages/track_log.hpp"
+#include "core/error.hpp"
+#include "eval/flo_io.hpp"
+#include "eval/kitti_flow.hpp"
+#include "eval/otb_score.hpp"
+#include "eval/track_log.hpp"
 
 namespace roiflow::fuzz {
 
@@ -49,9 +49,9 @@ inline bool finite_box(const cv::Rect2f& r) {
 // Scores a track against a truth (both already parsed) and checks the figures' ranges.
 inline void check_score(const std::vector<cv::Rect2f>& track,
                         const std::vector<cv::Rect2f>& truth) {
-  stages::OtbScore s;
+  eval::OtbScore s;
   try {
-    s = stages::score(track, truth);
+    s = eval::score(track, truth);
   } catch (const Error&) {
     return;  // nothing to score
   }
@@ -66,7 +66,7 @@ inline void check_score(const std::vector<cv::Rect2f>& track,
 inline void check_flo(std::string_view bytes) {
   cv::Mat flow;
   try {
-    flow = flow::parse_flo(bytes, "fuzz.flo");
+    flow = eval::parse_flo(bytes, "fuzz.flo");
   } catch (const Error&) {
     return;
   }
@@ -86,7 +86,7 @@ inline void check_flo(std::string_view bytes) {
 inline void check_ground_truth(std::string_view text) {
   std::vector<cv::Rect2f> boxes;
   try {
-    boxes = stages::parse_ground_truth(text, "fuzz.txt");
+    boxes = eval::parse_ground_truth(text, "fuzz.txt");
   } catch (const Error&) {
     return;
   }
@@ -101,13 +101,13 @@ inline void check_ground_truth(std::string_view text) {
 }
 
 inline void check_track_csv(std::string_view text) {
-  std::vector<stages::TrackRecord> records;
+  std::vector<eval::TrackRecord> records;
   try {
-    records = stages::parse_track_csv(text, "fuzz.csv");
+    records = eval::parse_track_csv(text, "fuzz.csv");
   } catch (const Error&) {
     return;
   }
-  for (const stages::TrackRecord& r : records) {
+  for (const eval::TrackRecord& r : records) {
     require(r.frame >= 1, "track csv: frame < 1 accepted");
     require(finite_box(r.box) && r.box.width >= 0 && r.box.height >= 0,
             "track csv: a box that is not finite or has a negative size");
@@ -116,7 +116,7 @@ inline void check_track_csv(std::string_view text) {
   }
   std::vector<cv::Rect2f> boxes;
   try {
-    boxes = stages::track_boxes(records);
+    boxes = eval::track_boxes(records);
   } catch (const Error&) {
     return;
   }
@@ -128,12 +128,12 @@ inline void check_track_csv(std::string_view text) {
 inline void check_kitti_round_trip(const cv::Mat& png) {
   cv::Mat flow;
   try {
-    flow = stages::decode_kitti_flow(png);
+    flow = eval::decode_kitti_flow(png);
   } catch (const Error&) {
     return;
   }
   require(flow.size() == png.size() && flow.type() == CV_32FC2, "kitti: size or type changed");
-  const cv::Mat again = stages::encode_kitti_flow(flow);  // decoded values are always in range
+  const cv::Mat again = eval::encode_kitti_flow(flow);  // decoded values are always in range
   for (int y = 0; y < png.rows; ++y) {
     for (int x = 0; x < png.cols; ++x) {
       const cv::Vec3w p = png.at<cv::Vec3w>(y, x);

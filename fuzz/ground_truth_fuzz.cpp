@@ -1,4 +1,4 @@
-// libFuzzer target: the OTB ground-truth parser (stages::parse_ground_truth, which
+// libFuzzer target: the OTB ground-truth parser (eval::parse_ground_truth, which
 // read_ground_truth uses) and the scoring of what it returns.
 #include <cstddef>
 #include <cstdint>

@@ -1,4 +1,4 @@
-// libFuzzer target: the KITTI 16-bit PNG flow reader (src/stages/kitti_flow.cpp) behind
+// libFuzzer target: the KITTI 16-bit PNG flow reader (src/eval/kitti_flow.cpp) behind
 // cv::imdecode, checked by re-encoding (see fuzz_checks.hpp).
 #include <cstddef>
 #include <cstdint>

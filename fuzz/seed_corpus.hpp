@@ -1,6 +1,7 @@
 // The fuzz targets' seed corpus: valid inputs written by the project's own writers (write_flo,
-// TrackLogWriter) plus hand-written ground truth and argument lists. fuzz/fuzz_seeds.cpp writes
-// them out for scripts/fuzz.sh; tests/fuzz_regression_test.cpp checks that every seed parses.
+// the track-log format) plus hand-written ground truth and argument lists. fuzz/fuzz_seeds.cpp
+// writes them out for scripts/fuzz.sh; tests/eval/fuzz_regression_test.cpp checks that every seed
+// parses.
 //
 //   for (const auto& [target, seeds] : roiflow::fuzz::seed_corpus(tmp_dir)) ...
 #pragma once
@@ -14,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "flow/flo_io.hpp"
-#include "stages/kitti_flow.hpp"
-#include "stages/track_log.hpp"
+#include "eval/flo_io.hpp"
+#include "eval/kitti_flow.hpp"
+#include "eval/track_log.hpp"
 
 namespace roiflow::fuzz {
 
@@ -38,7 +39,7 @@ inline std::map<std::string, std::vector<std::string>> seed_corpus(
     cv::randu(flow, -5.f, 5.f);
     if (size.area() > 1) flow.at<cv::Vec2f>(0, 0) = cv::Vec2f(1e10f, 0.f);  // unknown pixel
     const std::filesystem::path path = scratch / "seed.flo";
-    flow::write_flo(path.string(), flow);
+    eval::write_flo(path.string(), flow);
     seeds["flo"].push_back(file_bytes(path));
   }
 
@@ -47,7 +48,7 @@ inline std::map<std::string, std::vector<std::string>> seed_corpus(
     cv::randu(flow, -20.f, 20.f);
     if (size.area() > 1) flow.at<cv::Vec2f>(1, 2) = cv::Vec2f(1e10f, 1e10f);  // invalid pixel
     std::vector<uchar> png;
-    cv::imencode(".png", stages::encode_kitti_flow(flow), png);
+    cv::imencode(".png", eval::encode_kitti_flow(flow), png);
     seeds["kitti_flow"].emplace_back(png.begin(), png.end());
   }
 
@@ -58,25 +59,22 @@ inline std::map<std::string, std::vector<std::string>> seed_corpus(
   };
 
   {
-    const std::filesystem::path path = scratch / "seed.csv";
-    {
-      stages::TrackLogWriter log(path.string());
-      stages::TrackRecord r;
-      r.box = {70, 51, 107, 87};
-      log.write(r);
-      r.frame = 2;
-      r.box = {71.25f, 50.5f, 107, 87};
-      r.velocity = {1.25f, -0.5f};
-      r.mode = stages::TrackRecord::Mode::Global;
-      r.lost = true;
-      r.ms = 3.5;
-      log.write(r);
-      r.frame = 3;
-      r.box = {0, 0, 0, 0};
-      r.ms = 0.125;
-      log.write(r);
-    }
-    seeds["track_csv"].push_back(file_bytes(path));
+    std::string csv = std::string(eval::kTrackCsvHeader) + "\n";
+    eval::TrackRecord r;
+    r.box = {70, 51, 107, 87};
+    csv += eval::track_csv_row(r);
+    r.frame = 2;
+    r.box = {71.25f, 50.5f, 107, 87};
+    r.velocity = {1.25f, -0.5f};
+    r.mode = eval::TrackRecord::Mode::Global;
+    r.lost = true;
+    r.ms = 3.5;
+    csv += eval::track_csv_row(r);
+    r.frame = 3;
+    r.box = {0, 0, 0, 0};
+    r.ms = 0.125;
+    csv += eval::track_csv_row(r);
+    seeds["track_csv"].push_back(csv);
   }
 
   seeds["cli_options"] = {

@@ -1,5 +1,5 @@
-// libFuzzer target: the track-log CSV parser (stages::parse_track_csv, which read_track_csv
-// uses), stages::track_boxes and the scoring of the boxes.
+// libFuzzer target: the track-log CSV parser (eval::parse_track_csv, which read_track_csv
+// uses), eval::track_boxes and the scoring of the boxes.
 #include <cstddef>
 #include <cstdint>
 #include <string_view>

@@ -8,7 +8,7 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "flow/error.hpp"
+#include "core/error.hpp"
 #include "flow/metrics.hpp"
 
 namespace roiflow::flow {

@@ -29,7 +29,7 @@
 #include <string_view>
 #include <vector>
 
-#include "flow/executor.hpp"
+#include "core/executor.hpp"
 #include "flow/pyramid.hpp"
 
 namespace roiflow::flow {

@@ -12,8 +12,8 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "core/executor.hpp"
 #include "flow/dense_lk.hpp"
-#include "flow/executor.hpp"
 #include "flow/lk_kernels.hpp"
 
 namespace roiflow::flow::detail {

@@ -2,8 +2,8 @@
 #include <string_view>
 #include <vector>
 
+#include "core/error.hpp"
 #include "flow/dense_lk.hpp"
-#include "flow/error.hpp"
 #include "flow/pyramid.hpp"
 
 namespace roiflow::flow {

@@ -5,8 +5,7 @@
 #include <numbers>
 #include <string>
 
-#include "flow/error.hpp"
-#include "flow/flo_io.hpp"
+#include "core/error.hpp"
 
 namespace roiflow::flow {
 namespace {

@@ -23,6 +23,9 @@ struct FlowErrors {
   long long pixels = 0;  // pixels counted
 };
 
+// Flow with |u| or |v| above this is unknown (Middlebury's convention).
+inline constexpr float kUnknownFlowThreshold = 1e9f;
+
 bool is_known_flow(float u, float v);
 
 // Throws roiflow::Error when types or sizes differ (message gives both sizes), and when the

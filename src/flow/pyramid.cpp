@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "flow/error.hpp"
+#include "core/error.hpp"
 
 namespace roiflow::flow {
 

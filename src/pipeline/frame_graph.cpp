@@ -12,7 +12,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "flow/error.hpp"
+#include "core/error.hpp"
 #include "pipeline/tbb_executor.hpp"
 
 namespace roiflow::pipeline {

@@ -48,7 +48,7 @@
 
 #include "flow/dense_lk.hpp"
 #include "flow/pyramid.hpp"
-#include "stages/run_stats.hpp"
+#include "report/run_stats.hpp"
 #include "stages/tracker.hpp"
 #include "stages/video_source.hpp"
 
@@ -64,7 +64,7 @@ struct GraphOptions {
   int threads = 0;        // worker threads (a task_arena of this size); 0 = all hardware threads
   int max_in_flight = 0;  // frames between source and retirement; 0 = 2 * threads + 2
   const std::atomic<bool>* cancel = nullptr;  // set to stop reading; frames in flight finish
-  stages::RunStats* stats = nullptr;          // per-stage times ("decode", "pyramid", ...)
+  report::RunStats* stats = nullptr;          // per-stage times ("decode", "pyramid", ...)
   // Called at the start of every stage body with the frame's sequence number (tests inject
   // delays and failures here). Must be thread-safe.
   std::function<void(Stage, long long seq)> on_stage;

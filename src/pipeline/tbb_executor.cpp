@@ -11,13 +11,13 @@
 #include <opencv2/core/utility.hpp>
 #include <string>
 
-#include "flow/error.hpp"
+#include "core/error.hpp"
 
 namespace roiflow::pipeline {
 
 namespace {
 
-class TbbJob final : public flow::Job {
+class TbbJob final : public Job {
  public:
   explicit TbbJob(std::function<void()> job) {
     tbb::this_task_arena::enqueue(group_.defer(std::move(job)));
@@ -73,8 +73,8 @@ int TbbExecutor::concurrency() const {
   return tbb::this_task_arena::max_concurrency();
 }
 
-std::unique_ptr<flow::Job> TbbExecutor::start(std::function<void()> job) const {
-  if (tbb::this_task_arena::max_concurrency() == 1) return flow::Executor::start(std::move(job));
+std::unique_ptr<Job> TbbExecutor::start(std::function<void()> job) const {
+  if (tbb::this_task_arena::max_concurrency() == 1) return Executor::start(std::move(job));
   return std::make_unique<TbbJob>(std::move(job));
 }
 

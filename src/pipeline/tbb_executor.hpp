@@ -17,13 +17,13 @@
 #include <functional>
 #include <utility>
 
-#include "flow/executor.hpp"
+#include "core/executor.hpp"
 
 namespace roiflow::pipeline {
 
 inline constexpr int kMaxThreads = 256;
 
-class TbbExecutor final : public flow::Executor {
+class TbbExecutor final : public Executor {
  public:
   // Every sub-range is at least `grain` long unless [begin, end) itself is shorter; grain < 1
   // counts as 1. An exception thrown by body cancels the remaining sub-ranges and is rethrown.
@@ -34,7 +34,7 @@ class TbbExecutor final : public flow::Executor {
   // With more than one thread: `job` as a task of the caller's arena (a tbb::task_group), which
   // an idle thread takes while the caller goes on. The job must be waited for before that
   // arena ends (run_tracking waits for the tracker's through TrackStep::drain).
-  std::unique_ptr<flow::Job> start(std::function<void()> job) const override;
+  std::unique_ptr<Job> start(std::function<void()> job) const override;
 };
 
 // Holds OpenCV at `threads` threads and owns an arena of `threads` slots while it lives.

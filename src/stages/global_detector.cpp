@@ -7,8 +7,8 @@
 #include <opencv2/video/background_segm.hpp>
 #include <string>
 
-#include "flow/error.hpp"
-#include "stages/number_text.hpp"
+#include "core/error.hpp"
+#include "core/text.hpp"
 #include "stages/template_search.hpp"
 
 namespace roiflow::stages {

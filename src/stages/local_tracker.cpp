@@ -6,8 +6,8 @@
 #include <opencv2/imgproc.hpp>
 #include <utility>
 
-#include "flow/error.hpp"
-#include "stages/number_text.hpp"
+#include "core/error.hpp"
+#include "core/text.hpp"
 #include "stages/template_search.hpp"
 
 namespace roiflow::stages {
@@ -219,7 +219,7 @@ const char* to_string(LostReason reason) {
 
 struct LocalTracker::Impl {
   LocalTrackerParams params;
-  const flow::Executor* executor = nullptr;
+  const Executor* executor = nullptr;
   cv::Size size;         // of the frames; empty before start()
   int frame_levels = 1;  // effective levels of a whole-frame pyramid (lk.levels) at that size
   int levels = 1;        // levels of this step's pyramid parts (more when LK runs coarser)
@@ -731,7 +731,7 @@ cv::Point2f LocalTracker::Impl::measure_motion(double& scale) {
   return motion;
 }
 
-LocalTracker::LocalTracker(const LocalTrackerParams& params, const flow::Executor* executor)
+LocalTracker::LocalTracker(const LocalTrackerParams& params, const Executor* executor)
     : impl_(std::make_unique<Impl>()) {
   params.validate();
   impl_->params = params;

@@ -54,8 +54,8 @@
 #include <string>
 #include <vector>
 
+#include "core/executor.hpp"
 #include "flow/dense_lk.hpp"
-#include "flow/executor.hpp"
 #include "flow/pyramid.hpp"
 
 namespace roiflow::stages {
@@ -132,8 +132,7 @@ class LocalTracker {
  public:
   // `executor` splits LK into row stripes (nullptr = serial); it must outlive the tracker.
   // Throws roiflow::Error on bad params.
-  explicit LocalTracker(const LocalTrackerParams& params = {},
-                        const flow::Executor* executor = nullptr);
+  explicit LocalTracker(const LocalTrackerParams& params = {}, const Executor* executor = nullptr);
   ~LocalTracker();
   LocalTracker(LocalTracker&&) noexcept;
   LocalTracker& operator=(LocalTracker&&) noexcept;

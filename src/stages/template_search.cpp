@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "flow/error.hpp"
+#include "core/error.hpp"
 
 namespace roiflow::stages {
 namespace {

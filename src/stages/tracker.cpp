@@ -9,8 +9,8 @@
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
-#include "flow/error.hpp"
-#include "stages/number_text.hpp"
+#include "core/error.hpp"
+#include "core/text.hpp"
 
 namespace roiflow::stages {
 namespace {
@@ -59,7 +59,7 @@ double background_motion(const cv::Mat& flow, const cv::Rect& region, const cv::
 // pixels move.
 cv::Rect2f refine_by_motion(const flow::Pyramid& previous, const flow::Pyramid& current,
                             const flow::LkParams& lk, const cv::Rect2f& box,
-                            const flow::Executor* executor) {
+                            const Executor* executor) {
   const cv::Size size = current.size();
   const float pad = 0.1f * std::max(box.width, box.height) + 8.f;
   const cv::Rect region = cv::Rect(cv::Point(static_cast<int>(std::floor(box.x - pad)),
@@ -180,10 +180,10 @@ struct Tracker::Impl {
     return l;
   }
 
-  Impl(const TrackerParams& p, const flow::Executor* executor_)
+  Impl(const TrackerParams& p, const Executor* executor_)
       : params(p), local(local_params(p), executor_), detector(p.detector), executor(executor_) {}
 
-  const flow::Executor* executor;
+  const Executor* executor;
   // The last frame's gray image, and its whole pyramid while the target is being acquired
   // (refine_by_motion needs both frames' whole pyramids; the local treatment builds its own).
   cv::Mat previous_gray;
@@ -193,7 +193,7 @@ struct Tracker::Impl {
   // the detector's background model only; set_target_size, the one detector call a held frame
   // makes, touches the target's size). Waited for before the model is used again. Declared
   // last: destroyed (so waited for) before everything it touches.
-  std::unique_ptr<flow::Job> refresh;
+  std::unique_ptr<Job> refresh;
 
   // Waits for the background refresh; rethrows what it threw.
   void finish_refresh() {
@@ -356,7 +356,7 @@ TrackerOutput Tracker::Impl::process(const TrackerInput& frame) {
   return out;
 }
 
-Tracker::Tracker(const TrackerParams& params, const flow::Executor* executor)
+Tracker::Tracker(const TrackerParams& params, const Executor* executor)
     : impl_(std::make_unique<Impl>(params, executor)) {}
 
 Tracker::~Tracker() = default;

@@ -37,15 +37,18 @@
 #include <optional>
 #include <string_view>
 
+#include "core/executor.hpp"
+#include "eval/track_log.hpp"
 #include "flow/dense_lk.hpp"
-#include "flow/executor.hpp"
 #include "flow/pyramid.hpp"
 #include "stages/deferred_image.hpp"
 #include "stages/global_detector.hpp"
 #include "stages/local_tracker.hpp"
-#include "stages/track_log.hpp"
 
 namespace roiflow::stages {
+
+// The record the track log holds (eval/track_log.hpp); TrackerOutput::record() fills it.
+using eval::TrackRecord;
 
 enum class TrackMode { Local, Global };
 
@@ -118,7 +121,7 @@ class Tracker {
   // `executor` splits LK over row tiles of the region and runs the background model's refresh
   // beside the frames while the target is held (nullptr = everything serial, at once); it must
   // outlive the tracker. The results never depend on it. Throws roiflow::Error on bad params.
-  explicit Tracker(const TrackerParams& params, const flow::Executor* executor = nullptr);
+  explicit Tracker(const TrackerParams& params, const Executor* executor = nullptr);
   ~Tracker();
   Tracker(Tracker&&) noexcept;
   Tracker& operator=(Tracker&&) noexcept;

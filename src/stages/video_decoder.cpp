@@ -14,7 +14,7 @@ extern "C" {
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
-#include "flow/error.hpp"
+#include "core/error.hpp"
 
 namespace roiflow::stages {
 namespace {

@@ -12,8 +12,8 @@
 #include <system_error>
 #include <utility>
 
-#include "flow/error.hpp"
-#include "stages/atomic_write.hpp"
+#include "core/error.hpp"
+#include "eval/image_io.hpp"
 
 namespace roiflow::stages {
 namespace {
@@ -146,7 +146,7 @@ void VideoSink::write(const cv::Mat& frame) {
   if (writer_) {
     writer_->write(bgr);
   } else {
-    write_image_atomically((fs::path(path_) / frame_name(frames_ + 1)).string(), bgr);
+    eval::write_image_atomically((fs::path(path_) / frame_name(frames_ + 1)).string(), bgr);
   }
   ++frames_;
 }

@@ -18,8 +18,8 @@
 #include <utility>
 #include <vector>
 
-#include "flow/error.hpp"
-#include "flow/tracking_scene.hpp"
+#include "core/error.hpp"
+#include "eval/tracking_scene.hpp"
 #include "stages/video_decoder.hpp"
 
 namespace roiflow::stages {
@@ -74,41 +74,6 @@ bool is_image_extension(std::string extension) {
   for (const char* known : {".jpg", ".jpeg", ".png", ".bmp", ".pgm", ".ppm", ".tif", ".tiff"})
     if (extension == known) return true;
   return false;
-}
-
-// Why `bytes`, a PNG or JPEG file, is cut short or damaged in its structure, or "" when it
-// looks whole (other formats: ""). Decoders print their complaints about such files on stderr
-// and, for JPEG, return the picture with its missing part gray: a silently wrong frame.
-std::string image_damage(const std::vector<uchar>& bytes) {
-  const auto byte_at = [&](std::size_t i) { return static_cast<unsigned>(bytes[i]); };
-  static constexpr unsigned char kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-  if (bytes.size() >= 8 && std::equal(kPng, kPng + 8, bytes.begin())) {
-    // Chunks: 4-byte big-endian length, 4-letter type, data, 4-byte CRC; the last is IEND.
-    std::size_t at = 8;
-    while (at + 12 <= bytes.size()) {
-      const std::size_t length =
-          byte_at(at) << 24 | byte_at(at + 1) << 16 | byte_at(at + 2) << 8 | byte_at(at + 3);
-      for (std::size_t k = at + 4; k < at + 8; ++k)
-        if (!std::isalpha(static_cast<unsigned char>(bytes[k])))
-          return "damaged PNG (no valid chunk at byte " + std::to_string(at) + ")";
-      if (std::string_view(reinterpret_cast<const char*>(&bytes[at + 4]), 4) == "IEND") return {};
-      if (length > bytes.size() - at - 12) break;
-      at += length + 12;
-    }
-    return "truncated PNG (it ends before its IEND chunk)";
-  }
-  if (bytes.size() >= 3 && byte_at(0) == 0xFF && byte_at(1) == 0xD8 && byte_at(2) == 0xFF) {
-    // Inside entropy-coded data 0xFF is always followed by 0x00 or a restart marker, so an
-    // FF D9 after the first start-of-scan (FF DA) is the end-of-image marker.
-    bool scan = false;
-    for (std::size_t i = 2; i + 1 < bytes.size(); ++i) {
-      if (byte_at(i) != 0xFF) continue;
-      if (byte_at(i + 1) == 0xDA) scan = true;
-      if (scan && byte_at(i + 1) == 0xD9) return {};
-    }
-    return "truncated JPEG (no end-of-image marker after its image data)";
-  }
-  return {};
 }
 
 // The sorted entry names of `dir`; throws naming `dir` when it cannot be listed.
@@ -255,7 +220,7 @@ class SequenceReader : public VideoSource::Reader {
       return false;
     }
     try {
-      frame.image = read_image(path, cv::IMREAD_ANYCOLOR);
+      frame.image = eval::read_image(path, cv::IMREAD_ANYCOLOR);
     } catch (const Error& e) {
       failure = e.what();
       return false;
@@ -319,7 +284,7 @@ class VideoFileReader : public VideoSource::Reader {
       : label_("video " + quoted(path)), decoder_(path, threads, defer_colour) {
     // Checked before the first frame is decoded: a huge frame would be allocated by then.
     const cv::Size announced = decoder_.size();
-    if (announced.width > 0 && announced.height > 0) check_frame_size(announced, label_);
+    if (announced.width > 0 && announced.height > 0) eval::check_frame_size(announced, label_);
     fps_ = decoder_.fps() > 0 ? decoder_.fps() : default_fps;
   }
 
@@ -372,18 +337,6 @@ class VideoFileReader : public VideoSource::Reader {
   }
 };
 
-// Why frames of `size` cannot be processed ("10000x10000: larger than ..."), or "" when they can.
-std::string frame_size_problem(cv::Size size) {
-  const long long pixels = static_cast<long long>(size.width) * size.height;
-  if (size.width > kMaxFrameSide || size.height > kMaxFrameSide || pixels > kMaxFramePixels)
-    return size_string(size) + ": larger than the limit of " + std::to_string(kMaxFrameSide) +
-           " px a side and " + std::to_string(kMaxFramePixels / 1'000'000) + " Mpixel";
-  if (size.width < kMinFrameSide || size.height < kMinFrameSide)
-    return size_string(size) + ": smaller than the minimum of " + std::to_string(kMinFrameSide) +
-           " px a side";
-  return {};
-}
-
 // "synthetic:N[:WxH]": the tracking scene played forwards and backwards, rendered on demand.
 class SyntheticReader : public VideoSource::Reader {
  public:
@@ -413,10 +366,10 @@ class SyntheticReader : public VideoSource::Reader {
  private:
   long long frames_;
   double fps_;
-  flow::TrackingScene scene_;
+  eval::TrackingScene scene_;
 
-  static flow::TrackingSceneParams scene_params(cv::Size size) {
-    flow::TrackingSceneParams params;
+  static eval::TrackingSceneParams scene_params(cv::Size size) {
+    eval::TrackingSceneParams params;
     params.size = size;
     params.frames = kSceneFrames;
     // The default vehicle and jump are drawn for 640 px: scaled so that any size keeps the
@@ -450,11 +403,12 @@ std::unique_ptr<VideoSource::Reader> open_synthetic(const std::string& input, do
     const std::string_view h = x == std::string_view::npos ? "" : size_text.substr(x + 1);
     const auto width = all_digits(w) ? parse_number(w) : std::nullopt;
     const auto height = all_digits(h) ? parse_number(h) : std::nullopt;
-    if (!width || !height || *width < 64 || *height < 64 || *width > kMaxFrameSide ||
-        *height > kMaxFrameSide)
-      throw bad("the size must be WxH with each side in 64.." + std::to_string(kMaxFrameSide));
+    if (!width || !height || *width < 64 || *height < 64 || *width > eval::kMaxFrameSide ||
+        *height > eval::kMaxFrameSide)
+      throw bad("the size must be WxH with each side in 64.." +
+                std::to_string(eval::kMaxFrameSide));
     size = {static_cast<int>(*width), static_cast<int>(*height)};
-    check_frame_size(size, "synthetic input " + quoted(input));
+    eval::check_frame_size(size, "synthetic input " + quoted(input));
   }
   return std::make_unique<SyntheticReader>(*count, size, fps);
 }
@@ -497,25 +451,6 @@ std::unique_ptr<VideoSource::Reader> open_reader(const std::string& input, doubl
 }
 
 }  // namespace
-
-cv::Mat read_image(const std::string& path, int flags) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error("cannot open image " + quoted(path));
-  const std::vector<uchar> bytes((std::istreambuf_iterator<char>(in)),
-                                 std::istreambuf_iterator<char>());
-  if (in.bad()) throw Error("cannot read image " + quoted(path));
-  if (bytes.empty()) throw Error("cannot decode image " + quoted(path) + ": empty file");
-  if (const std::string damage = image_damage(bytes); !damage.empty())
-    throw Error("cannot decode image " + quoted(path) + ": " + damage);
-  cv::Mat image = cv::imdecode(bytes, flags);
-  if (image.empty()) throw Error("cannot decode image " + quoted(path));
-  return image;
-}
-
-void check_frame_size(cv::Size size, const std::string& what) {
-  if (const std::string problem = frame_size_problem(size); !problem.empty())
-    throw Error(what + " is " + problem);
-}
 
 VideoSource::VideoSource(const std::string& input, const VideoSourceParams& params)
     : params_(params) {
@@ -588,7 +523,7 @@ std::optional<Frame> VideoSource::read_frame(long long index, std::string& failu
   }
   if (size_.empty()) {
     // The first frame: checked before a gray copy of a huge image is made.
-    failure = frame_size_problem(checked.size());
+    failure = eval::frame_size_problem(checked.size());
     if (!failure.empty()) {
       failure = "frame size " + failure;
       return std::nullopt;

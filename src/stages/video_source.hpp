@@ -20,7 +20,7 @@
 //   - a path holding one printf conversion (%d, %4d or %04d), like "img/%04d.jpg": an image
 //     sequence made of the files of that folder that match, run as above.
 //   - "synthetic:N" or "synthetic:N:WxH" (when no such file exists): N frames (1..10^9) of
-//     flow::TrackingScene's fixed-camera scene, WxH (default 640x480, each side 64..8192; the
+//     eval::TrackingScene's fixed-camera scene, WxH (default 640x480, each side 64..8192; the
 //     vehicle and its jump scaled with the width), rendered on the fly. The scene is 300
 //     frames long and plays forwards, then backwards, then forwards again (frame i shows scene
 //     frame i mod 598, mirrored past 299), so a stream of any length holds one scene and one
@@ -63,25 +63,10 @@
 #include <optional>
 #include <string>
 
-#include "flow/pyramid.hpp"
+#include "eval/image_io.hpp"
 #include "stages/deferred_image.hpp"
 
 namespace roiflow::stages {
-
-inline constexpr int kMinFrameSide = flow::kMinLevelSide;  // one pyramid level
-inline constexpr int kMaxFrameSide = 8192;
-inline constexpr long long kMaxFramePixels = 40'000'000;
-
-// Throws roiflow::Error when `size` is out of the limits above, naming `what` (e.g. "image
-// 'a.png'") and the size. flow and eval apply it to their images too.
-void check_frame_size(cv::Size size, const std::string& what);
-
-// The image file at `path`, decoded with cv::imdecode(`flags`). Throws roiflow::Error naming
-// the file when it cannot be read or decoded, and also when a PNG or JPEG file is cut short or
-// its chunk structure is damaged, which decoders would otherwise report only on stderr (and,
-// for JPEG, answer with a picture whose missing part is gray). Image sequences read their
-// frames with it.
-cv::Mat read_image(const std::string& path, int flags);
 
 struct VideoSourceParams {
   double fps = 25;           // frame rate of image sequences, and of videos or cameras that

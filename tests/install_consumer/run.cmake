@@ -20,8 +20,9 @@ set(prefix ${WORK_DIR}/prefix)
 run_step("cmake --install" ${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix})
 
 # What the package promises is in place.
-foreach(file bin/roiflow include/roiflow/flow/dense_lk.hpp include/roiflow/stages/tracker.hpp
-             include/roiflow/pipeline/frame_graph.hpp)
+foreach(file bin/roiflow include/roiflow/core/error.hpp include/roiflow/flow/dense_lk.hpp
+             include/roiflow/eval/flo_io.hpp include/roiflow/report/plot.hpp
+             include/roiflow/stages/tracker.hpp include/roiflow/pipeline/frame_graph.hpp)
   if(NOT EXISTS ${prefix}/${file})
     message(FATAL_ERROR "install consumer: ${prefix}/${file} was not installed")
   endif()
@@ -33,7 +34,8 @@ if(NOT config OR NOT targets)
 endif()
 # Build-only flags must not reach consumers.
 file(READ ${targets} exported)
-foreach(flag -march=native -Wall -fsanitize roiflow_warnings /work/)
+foreach(flag -march=native -Wall -fsanitize roiflow_warnings roiflow_native_arch roiflow_sanitizers
+             roiflow_build_flags include_roots /work/)
   string(FIND "${exported}" "${flag}" at)
   if(NOT at EQUAL -1)
     message(FATAL_ERROR "install consumer: ${targets} exports '${flag}'")

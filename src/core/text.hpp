@@ -1,0 +1,63 @@
+// Text for the places it is shown: numbers as the user wrote them, values quoted for an error
+// message, and text made safe for HTML or SVG.
+//
+//   throw Error("roi must be in 8..4096, got " + number_text(roi));
+//   throw Error(path + ":" + std::to_string(line) + ": bad number " + quoted_excerpt(field));
+//   svg += "<text>" + escape_markup(label) + "</text>";
+#pragma once
+
+#include <cstddef>
+#include <sstream>
+#include <string>
+#include <string_view>
+
+namespace roiflow {
+
+// A number as error messages show it: the shortest stream form ("0.5", "1e-06", "nan"), so that
+// the value the user gave reads back as they wrote it.
+inline std::string number_text(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+// A value quoted for an error message, cut to 40 characters: a binary file read as text must
+// not produce a screenful.
+inline std::string quoted_excerpt(std::string_view text) {
+  constexpr std::size_t kMax = 40;
+  std::string shown(1, '\'');
+  shown.append(text.substr(0, kMax));
+  shown.append(text.size() > kMax ? "...'" : "'");
+  return shown;
+}
+
+// Text for HTML or XML (SVG) content and attribute values: the five special characters as
+// entities, control characters other than tab dropped (XML 1.0 does not allow them).
+inline std::string escape_markup(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (char c : text) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&#39;";
+        break;
+      default:
+        if (static_cast<unsigned char>(c) >= 0x20 || c == '\t') out += c;
+    }
+  }
+  return out;
+}
+
+}  // namespace roiflow

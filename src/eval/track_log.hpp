@@ -1,0 +1,53 @@
+// The track-log format: one record per frame of a tracking run, as CSV or JSON, and its reader.
+//
+//   using namespace roiflow;
+//   const eval::TrackRecord r{.frame = 1, .box = {70, 51, 107, 87}};
+//   std::string csv = std::string(eval::kTrackCsvHeader) + "\n" + eval::track_csv_row(r);
+//   for (const eval::TrackRecord& back : eval::parse_track_csv(csv, "memory")) (void)back;
+//
+// CSV: the header `frame,x,y,w,h,vx,vy,mode,lost,ms`, then one line per record with the box to
+// 2 decimals, the velocity and ms to 3, mode `local` or `global`, lost `0` or `1`.
+// JSON: an array of objects with the same keys and the same rounding (lost is a boolean), one
+// record per line: `[\n{"frame":1,...},\n{"frame":2,...}\n]\n`. The writer that keeps such a
+// file valid while a run goes is stages::TrackLogWriter (stages/track_log_sink.hpp).
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace roiflow::eval {
+
+struct TrackRecord {
+  enum class Mode { Local, Global };
+
+  long long frame = 1;      // 1-based, like OTB's ground-truth lines
+  cv::Rect2f box;           // top-left corner and size, pixels
+  cv::Point2f velocity;     // pixels per frame
+  Mode mode = Mode::Local;  // which treatment produced the box
+  bool lost = false;
+  double ms = 0;  // tracker time spent on this frame, milliseconds
+};
+
+inline constexpr std::string_view kTrackCsvHeader = "frame,x,y,w,h,vx,vy,mode,lost,ms";
+
+const char* to_string(TrackRecord::Mode mode);  // "local" | "global"
+
+// Throws roiflow::Error, naming `path` and the frame, for a value a reader could not take back:
+// NaN, infinity, a frame below 1, a negative size.
+void check_track_record(const TrackRecord& record, const std::string& path);
+// One CSV line, '\n' included.
+std::string track_csv_row(const TrackRecord& record);
+// One JSON object on one line, without separators; the same values as the CSV line.
+std::string track_json_object(const TrackRecord& record);
+
+// Reads a track-log CSV. Strict, because scores are computed from it: the header must match
+// exactly, every row holds 10 fields, numbers parse completely and are finite (box and velocity
+// within the float range), mode is local|global and lost 0|1. Windows line ends are accepted.
+// Anything else throws roiflow::Error as `path:line: what was wrong`.
+std::vector<TrackRecord> read_track_csv(const std::string& path);
+// The same from a file's text held in memory; `name` stands for the path in error messages.
+std::vector<TrackRecord> parse_track_csv(std::string_view text, const std::string& name);
+
+}  // namespace roiflow::eval

@@ -1,0 +1,61 @@
+// The tracker's annotated video frame: what the tracker saw and decided, drawn on the input.
+//
+//   roiflow::report::TrackAnnotation a;                 // what the tracker decided for a frame
+//   a.has_target = true;
+//   a.box = {70, 51, 107, 87};
+//   a.velocity = {2.f, 0.f};
+//   cv::Mat bgr = roiflow::report::annotate_frame(cv::Mat(240, 320, CV_8UC1, 128), a);
+//
+// The annotation is a plain record, so that drawing needs no tracker: the pipeline fills it
+// from a stages::TrackerOutput. Drawn on a BGR copy of `image` (8-bit gray or BGR), in this
+// order:
+//  - the colour-coded flow (Middlebury, flow::flow_to_color) blended over the image inside
+//    `out.region`, when `out.region_flow` holds the flow of that region;
+//  - the region's outline;
+//  - the target's box when there is one: solid in `local_color` or `global_color` by the mode
+//    that produced it, dashed in `lost_color` when the target is lost (the box is then only
+//    the prediction), and an arrow from its centre showing the velocity, `arrow_scale` times
+//    longer than one frame's motion (a few pixels per frame would otherwise be invisible);
+//  - a text line in the top-left corner: "frame N  local|global", followed by "  lost" or
+//    "  no target" where that applies. N is 1-based (index + 1), like the track log's frames,
+//    so an annotated frame can be looked up in the log.
+// Boxes and regions partly or wholly outside the frame are clipped; nothing outside is drawn.
+// Lines are drawn without anti-aliasing, so the style's colours appear exactly in the result.
+// Throws roiflow::Error for an image that is not 8-bit gray or BGR, a region_flow that is not
+// CV_32FC2 of the region's size, or a bad style.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+namespace roiflow::report {
+
+// One frame's tracking result, as annotate_frame draws it.
+struct TrackAnnotation {
+  long long index = 0;      // 0-based frame index (shown 1-based, like the track log)
+  bool has_target = false;  // false until the target is known
+  cv::Rect2f box;           // the target's box (when has_target)
+  cv::Point2f velocity;     // pixels per frame
+  bool global = true;       // the box came from the global treatment (else the local one)
+  bool lost = false;        // the target was not found (box = prediction)
+  cv::Rect region;          // where LK ran (empty when it did not)
+  cv::Mat region_flow;      // CV_32FC2 flow over `region`, or empty
+};
+
+struct AnnotateStyle {
+  float flow_alpha = 0.6f;          // weight of the flow colours inside the region, 0..1
+  float flow_max_magnitude = -1.f;  // flow magnitude drawn fully saturated; <= 0: the region's
+                                    // largest (flow_to_color's rule)
+  float arrow_scale = 8.f;          // arrow length in pixels per pixel/frame of velocity, >= 0
+  int thickness = 2;                // line thickness in pixels, 1..16
+  bool text = true;                 // the "frame N ..." line
+  cv::Scalar region_color{255, 255, 255};  // BGR: white
+  cv::Scalar local_color{0, 255, 0};       // green
+  cv::Scalar global_color{255, 128, 0};    // blue
+  cv::Scalar lost_color{0, 0, 255};        // red
+  cv::Scalar arrow_color{0, 255, 255};     // yellow
+};
+
+cv::Mat annotate_frame(const cv::Mat& image, const TrackAnnotation& out,
+                       const AnnotateStyle& style = {});
+
+}  // namespace roiflow::report

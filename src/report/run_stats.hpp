@@ -1,0 +1,76 @@
+// RunStats: where a run's time went, per stage, from any number of threads at once.
+//
+//   roiflow::report::RunStats stats;
+//   {
+//     roiflow::report::ScopedTimer timer(stats, "pyramid");   // adds its lifetime on scope exit
+//     build_pyramid(...);
+//   }
+//   stats.add("lk", 3.2);                                      // or add milliseconds yourself
+//   stats.add_frames(1);
+//   nlohmann::ordered_json summary = stats.to_json(wall_seconds);
+//   summary["mode"] = "local";                                 // the caller adds its own fields
+//   std::cerr << stats.format(wall_seconds);
+//
+// A stage is created by its first add() and reported in first-use order, which for a pipeline
+// is the order of its nodes. to_json gives
+//   {"frames": N, "wall_s": s, "fps": N / s,
+//    "stages": {"<name>": {"calls": c, "ms_total": t, "ms_mean": t / c, "fps": c / (t / 1000)}}}
+// where a stage's fps is calls per second of its own busy time: what the stage alone could
+// sustain on one thread. A rate whose time is zero is null (JSON has no infinity).
+// Every member is thread-safe (one mutex: a few calls per frame cost nothing next to the work
+// they time). Bad values (negative or non-finite times, an empty stage name, negative frame
+// counts) throw roiflow::Error naming the value.
+#pragma once
+
+#include <chrono>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace roiflow::report {
+
+// The process's peak resident set size so far, in MiB (getrusage ru_maxrss); 0 where the
+// platform does not report it. Monotonic: a long run shows whether memory stays flat.
+double peak_rss_mb();
+
+class RunStats {
+ public:
+  void add(std::string_view stage, double ms);
+  void add_frames(long long n);
+
+  nlohmann::ordered_json to_json(double wall_seconds) const;
+  // A table for people:
+  //   300 frames in 4.21 s: 71.3 fps
+  //   stage        calls    total ms   mean ms      fps
+  //   pyramid        300      812.40     2.708    369.3
+  std::string format(double wall_seconds) const;
+
+ private:
+  struct Stage {
+    std::string name;
+    long long calls = 0;
+    double ms_total = 0;
+  };
+
+  mutable std::mutex mutex_;
+  std::vector<Stage> stages_;  // first-use order; a handful, so a linear search is fastest
+  long long frames_ = 0;
+};
+
+// Adds the time from construction to destruction to `stage` of `stats`, which must outlive it.
+class ScopedTimer {
+ public:
+  ScopedTimer(RunStats& stats, std::string_view stage);
+  ~ScopedTimer();
+  ScopedTimer(const ScopedTimer&) = delete;
+  ScopedTimer& operator=(const ScopedTimer&) = delete;
+
+ private:
+  RunStats& stats_;
+  std::string stage_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace roiflow::report

@@ -1,0 +1,184 @@
+// Dense LK's contract without ground truth: bad input, parameters, presets, tiny images.
+#include "flow/dense_lk.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <limits>
+#include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
+
+#include "core/error.hpp"
+#include "test_util.hpp"
+
+namespace roiflow::flow {
+namespace {
+
+using test::error_message;
+
+bool all_finite(const cv::Mat& m) {
+  return cv::checkRange(m, true, nullptr, -1e30, 1e30);
+}
+
+// A smooth random texture (8-bit), enough for LK to have gradients everywhere.
+cv::Mat texture(cv::Size size, std::uint64_t seed) {
+  cv::Mat noise(size, CV_8UC1);
+  cv::RNG rng(seed);
+  rng.fill(noise, cv::RNG::UNIFORM, 0, 256);
+  cv::Mat smooth;
+  cv::GaussianBlur(noise, smooth, cv::Size(), 1.5);
+  return smooth;
+}
+
+LkParams with_patch(LkParams p, int patch) {
+  p.patch = patch;
+  return p;
+}
+
+LkParams with_derivative(LkParams p, Derivative d) {
+  p.derivative = d;
+  return p;
+}
+
+struct NamedParams {
+  const char* name;
+  LkParams params;
+};
+
+std::vector<NamedParams> configurations() {
+  return {{"paper", LkParams::paper()},
+          {"paper patch 9", with_patch(LkParams::paper(), 9)},
+          {"accurate", LkParams::accurate()},
+          {"accurate patch 11 scharr",
+           with_derivative(with_patch(LkParams::accurate(), 11), Derivative::Scharr)}};
+}
+
+TEST(DenseLkTest, RejectsEmptyFrames) {
+  const cv::Mat frame(40, 30, CV_8UC1, cv::Scalar(7));
+  EXPECT_THROW(dense_flow(cv::Mat(), frame, LkParams::paper()), Error);
+  EXPECT_THROW(dense_flow(frame, cv::Mat(), LkParams::paper()), Error);
+  EXPECT_THROW(dense_flow(cv::Mat(), cv::Mat(), LkParams::paper()), Error);
+  EXPECT_THROW(dense_flow(Pyramid{}, Pyramid{}, LkParams::paper()), Error);
+}
+
+TEST(DenseLkTest, SizeMismatchNamesBothSizes) {
+  const cv::Mat a(240, 320, CV_8UC1, cv::Scalar(1)), b(120, 160, CV_8UC1, cv::Scalar(1));
+  const std::string msg = error_message([&] { dense_flow(a, b, LkParams::paper()); });
+  EXPECT_NE(msg.find("320x240"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("160x120"), std::string::npos) << msg;
+  EXPECT_THROW(dense_flow(build_pyramid(a, 3, 0.5), build_pyramid(b, 3, 0.5), LkParams::paper()),
+               Error);
+}
+
+TEST(DenseLkTest, RejectsUnsupportedType) {
+  const cv::Mat a(24, 32, CV_64FC1, cv::Scalar(0.5));
+  const std::string msg = error_message([&] { dense_flow(a, a, LkParams::paper()); });
+  EXPECT_NE(msg.find("64F"), std::string::npos) << msg;
+}
+
+TEST(DenseLkTest, RejectsPyramidWithTooFewLevels) {
+  const cv::Mat frame0 = texture({160, 120}, 2), frame1 = texture({160, 120}, 3);
+  const Pyramid p0 = build_pyramid(frame0, 2, 0.5), p1 = build_pyramid(frame1, 2, 0.5);
+  LkParams params = LkParams::paper();  // 3 levels
+  const std::string msg = error_message([&] { dense_flow(p0, p1, params); });
+  EXPECT_NE(msg.find("2 levels"), std::string::npos) << msg;
+  params.levels = 2;
+  EXPECT_NO_THROW(dense_flow(p0, p1, params));
+}
+
+TEST(DenseLkTest, RejectsEveryParameterOutOfRange) {
+  struct Case {
+    const char* field;  // the parameter the message must name
+    const char* value;  // and the value, as it prints
+    void (*apply)(LkParams&);
+  };
+  const Case cases[] = {
+      {"patch", "2", [](LkParams& p) { p.patch = 2; }},
+      {"patch", "32", [](LkParams& p) { p.patch = 32; }},
+      {"levels", "0", [](LkParams& p) { p.levels = 0; }},
+      {"levels", "7", [](LkParams& p) { p.levels = 7; }},
+      {"iterations", "0", [](LkParams& p) { p.iterations = 0; }},
+      {"iterations", "51", [](LkParams& p) { p.iterations = 51; }},
+      {"sigma", "-1", [](LkParams& p) { p.sigma = -1; }},
+      {"sigma", "nan", [](LkParams& p) { p.sigma = std::numeric_limits<double>::quiet_NaN(); }},
+      {"lambda", "0", [](LkParams& p) { p.lambda = 0; }},
+      {"robust", "-0.1", [](LkParams& p) { p.robust_scale = -0.1; }},
+      {"median", "4", [](LkParams& p) { p.level_median = 4; }},
+      {"median", "7", [](LkParams& p) { p.final_median = 7; }},
+  };
+  const cv::Mat frame(24, 32, CV_8UC1, cv::Scalar(9));
+  for (const Case& c : cases) {
+    LkParams params = LkParams::paper();
+    c.apply(params);
+    const std::string msg = error_message([&] { params.validate(); });
+    EXPECT_NE(msg.find(c.field), std::string::npos) << msg;
+    EXPECT_NE(msg.find(std::string("got ") + c.value), std::string::npos) << msg;
+    // dense_flow validates before it looks at the frames.
+    EXPECT_EQ(error_message([&] { dense_flow(frame, frame, params); }), msg);
+    EXPECT_EQ(error_message([&] { dense_flow(cv::Mat(), cv::Mat(), params); }), msg);
+  }
+}
+
+TEST(DenseLkTest, PresetsAndDerivativeNames) {
+  const LkParams paper = LkParams::paper();
+  EXPECT_EQ(paper.patch, 10);
+  EXPECT_EQ(paper.levels, 3);
+  EXPECT_EQ(paper.iterations, 3);
+  EXPECT_EQ(paper.derivative, Derivative::HornSchunck);
+  EXPECT_NO_THROW(paper.validate());
+  EXPECT_NO_THROW(LkParams::accurate().validate());
+  EXPECT_NO_THROW(LkParams{}.validate());
+  const std::vector<std::string> names = LkParams::preset_names();
+  EXPECT_NE(std::find(names.begin(), names.end(), "paper"), names.end());
+  EXPECT_NE(std::find(names.begin(), names.end(), "accurate"), names.end());
+  for (const std::string& name : names)
+    EXPECT_NO_THROW(LkParams::preset(name).validate()) << name;
+  EXPECT_EQ(LkParams::preset("paper").patch, paper.patch);
+  EXPECT_EQ(LkParams::preset("accurate").levels, LkParams::accurate().levels);
+  const std::string msg = error_message([] { LkParams::preset("nope"); });
+  EXPECT_NE(msg.find("nope"), std::string::npos) << msg;
+
+  for (const Derivative d : {Derivative::HornSchunck, Derivative::Scharr, Derivative::Central})
+    EXPECT_EQ(derivative_from_string(to_string(d)), d) << to_string(d);
+  const std::string bad = error_message([] { derivative_from_string("sobel"); });
+  EXPECT_NE(bad.find("sobel"), std::string::npos) << bad;
+}
+
+TEST(DenseLkTest, TinyImagesGiveFiniteFlowOfTheRightSize) {
+  cv::RNG rng(3);
+  for (const cv::Size size : {cv::Size(1, 1), cv::Size(2, 2), cv::Size(1, 50), cv::Size(50, 1),
+                              cv::Size(7, 5), cv::Size(13, 13), cv::Size(25, 24)}) {
+    cv::Mat a(size, CV_8UC1), b(size, CV_8UC1);
+    rng.fill(a, cv::RNG::UNIFORM, 0, 256);
+    rng.fill(b, cv::RNG::UNIFORM, 0, 256);
+    for (const NamedParams& c : configurations()) {
+      const FlowResult moved = dense_flow(a, b, c.params);
+      ASSERT_EQ(moved.flow.size(), size) << c.name << " " << size;
+      ASSERT_EQ(moved.flow.type(), CV_32FC2);
+      ASSERT_EQ(moved.confidence.size(), size);
+      EXPECT_TRUE(all_finite(moved.flow)) << c.name << " " << size;
+      EXPECT_TRUE(all_finite(moved.confidence)) << c.name << " " << size;
+
+      // Not exactly zero: the warp interpolates the last column and row with weight 1 on the
+      // far sample, p00 + 1 * (p01 - p00), which can miss p01 by an ulp (measured up to
+      // 1.5e-8 px, at 13x13 with Scharr).
+      const FlowResult still = dense_flow(a, a, c.params);
+      ASSERT_EQ(still.flow.size(), size);
+      EXPECT_LT(cv::norm(still.flow, cv::NORM_INF), 1e-7) << c.name << " " << size;
+    }
+  }
+}
+
+TEST(DenseLkTest, RegionOutsideTheFrameThrows) {
+  const cv::Mat frame0 = texture({160, 120}, 2), frame1 = texture({160, 120}, 3);
+  for (const cv::Rect region : {cv::Rect(160, 0, 10, 10), cv::Rect(-30, -30, 30, 30),
+                                cv::Rect(500, 500, 20, 20), cv::Rect(0, 120, 160, 5)}) {
+    FlowOptions options;
+    options.region = region;
+    EXPECT_THROW(dense_flow(frame0, frame1, LkParams::paper(), options), Error) << region;
+  }
+}
+
+}  // namespace
+}  // namespace roiflow::flow
