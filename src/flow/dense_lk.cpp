@@ -176,6 +176,10 @@ void flow_from_pyramids(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkPar
 
   ws.u.resize(levels);
   ws.v.resize(levels);
+  // The last iteration writes the result itself when it is level 0's whole computed rectangle
+  // and no median follows.
+  const bool direct =
+      plan.finest == 0 && params.final_median == 0 && region.size() == comp[0].size();
   for (int l = levels - 1; l >= 0; --l) {
     const cv::Rect& c = comp[l];
     if (l < plan.finest) {  // below the finest level the flow is only upsampled
@@ -193,6 +197,12 @@ void flow_from_pyramids(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkPar
                         : LevelInput::coarser(coarse_u, coarse_v, comp[l + 1].tl());
     const LevelProblem p = level_problem(pyr_t.levels[l], pyr_t1.levels[l], c, params);
     const bool finest = l == plan.finest;
+    if (finest && direct) {
+      iterate_level(p, input, ws.u[l], ws.v[l], &result.confidence, params.iterations, exec,
+                    ws.scratch, &result.flow);
+      result.region = region;
+      return;
+    }
     iterate_level(p, input, ws.u[l], ws.v[l], finest ? &ws.confidence : nullptr, params.iterations,
                   exec, ws.scratch);
     cv::Mat u = view(ws.u[l], c.size()), v = view(ws.v[l], c.size());
@@ -200,15 +210,23 @@ void flow_from_pyramids(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkPar
   }
 
   const cv::Rect crop(region.tl() - comp[0].tl(), region.size());
-  const cv::Mat planes[] = {view(ws.u[0], comp[0].size())(crop),
-                            view(ws.v[0], comp[0].size())(crop)};
-  result.flow.create(crop.size(), CV_32FC2);
-  cv::merge(planes, 2, result.flow);
+  const cv::Mat u = view(ws.u[0], comp[0].size())(crop), v = view(ws.v[0], comp[0].size())(crop);
   const cv::Mat confidence = view(ws.confidence, comp[plan.finest].size());
+  result.flow.create(crop.size(), CV_32FC2);
   if (plan.finest > 0) {
+    const cv::Mat planes[] = {u, v};
+    cv::merge(planes, 2, result.flow);
     confidence_to_level0(confidence, comp[plan.finest], plan.finest, region, result.confidence);
   } else {
-    confidence(crop).copyTo(result.confidence);
+    result.confidence.create(crop.size(), CV_32F);
+    // Row blocks on the executor: at VGA these copies are a few per cent of a pair.
+    exec.for_range(0, crop.height, 64, [&](int y0, int y1) {
+      const cv::Rect rows(0, y0, crop.width, y1 - y0);
+      const cv::Mat planes[] = {u(rows), v(rows)};
+      cv::Mat out = result.flow(rows);
+      cv::merge(planes, 2, out);
+      confidence(crop)(rows).copyTo(result.confidence(rows));
+    });
   }
   result.region = region;
 }
@@ -268,8 +286,18 @@ void DenseLK::calc(const cv::Mat& frame_t, const cv::Mat& frame_t1, FlowResult& 
   }
   if (!ws_) ws_ = std::make_unique<Workspace>();
   const int levels = flow_pyramid_levels(frame_t.size(), params_, options);
-  build_pyramid(frame_t, levels, params_.sigma, ws_->pyr_t);
-  build_pyramid(frame_t1, levels, params_.sigma, ws_->pyr_t1);
+  // The two pyramids side by side when there are threads for it.
+  const cv::Mat* frames[] = {&frame_t, &frame_t1};
+  Pyramid* pyramids[] = {&ws_->pyr_t, &ws_->pyr_t1};
+  auto build = [&](int b, int e) {
+    for (int i = b; i < e; ++i)
+      build_pyramid(*frames[i], levels, params_.sigma, *pyramids[i]);
+  };
+  if (executor_ && executor_->concurrency() > 1) {
+    executor_->for_range(0, 2, 1, build);
+  } else {
+    build(0, 2);
+  }
   flow_from_pyramids(ws_->pyr_t, ws_->pyr_t1, params_, result, options, executor_, *ws_);
 }
 

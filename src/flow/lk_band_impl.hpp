@@ -12,6 +12,7 @@
 
 #include "flow/lk_kernels.hpp"
 #include "flow/lk_kernels_impl.hpp"
+#include "flow/lk_rows_impl.hpp"
 
 #ifndef ROIFLOW_KERNEL_TABLE
 #error "define ROIFLOW_KERNEL_TABLE before including lk_band_impl.hpp"
@@ -64,12 +65,14 @@ constexpr int kChunk = 128;
 class RowPass {
  public:
   void init(const LevelJob& L, const FlowRows& in, const FlowRows& out, float* conf,
-            Idx conf_stride, float* scratch) {
+            Idx conf_stride, float* flow, Idx flow_stride, float* scratch) {
     L_ = &L;
     in_ = in;
     out_ = out;
     conf_ = conf;
     conf_stride_ = conf_stride;
+    flow_ = flow;
+    flow_stride_ = flow_stride;
     s_ = layout_of(L);
     for (int i = 0; i < 4; ++i) {
       cache_row_[i] = -1 << 30;
@@ -194,6 +197,7 @@ class RowPass {
       q.un = row_u(out_, y);
       q.vn = row_v(out_, y);
       q.conf = conf_ ? conf_ + static_cast<Idx>(y) * conf_stride_ : nullptr;
+      q.flow = flow_ ? flow_ + static_cast<Idx>(y) * flow_stride_ : nullptr;
     }
     for (int c = 0; c < kChannels * N; ++c)
       carry_[c] = 0.f;
@@ -237,14 +241,18 @@ class RowPass {
       }
     }
     solve_row(q, solved, w);
-    q.un[w] = q.un[w - 1];
-    q.vn[w] = q.vn[w - 1];
+    if (!flow_) {
+      q.un[w] = q.un[w - 1];
+      q.vn[w] = q.vn[w - 1];
+    }
   }
 
   const LevelJob* L_ = nullptr;
   FlowRows in_, out_;
   float* conf_ = nullptr;
   Idx conf_stride_ = 0;
+  float* flow_ = nullptr;
+  Idx flow_stride_ = 0;
   Layout s_{};
   float* m_[4] = {};
   float* d_[4] = {};
@@ -288,8 +296,9 @@ void run_band(const BandJob& job) {
   for (int k = 0; k < K; ++k) {
     const FlowRows& in = k == 0 ? job.input : job.rings[k - 1];
     const FlowRows& out = k == K - 1 ? job.output : job.rings[k];
-    passes[k].init(L, in, out, k == K - 1 ? job.confidence : nullptr, job.confidence_stride,
-                   job.scratch[k]);
+    const bool final_pass = k == K - 1;
+    passes[k].init(L, in, out, final_pass ? job.confidence : nullptr, job.confidence_stride,
+                   final_pass ? job.flow : nullptr, job.flow_stride, job.scratch[k]);
   }
   // Iteration k handles row y at time y + k * lag, kBatchRows times at once (its vertical sums
   // stay in cache over them): the rows it reads of iteration k - 1 (down to y + reach_down) are
@@ -310,7 +319,8 @@ void run_band(const BandJob& job) {
 }  // namespace
 
 extern const LkKernels ROIFLOW_KERNEL_TABLE;
-const LkKernels ROIFLOW_KERNEL_TABLE = {simd::kNativeName, Native::N, scratch_floats, run_band,
-                                        input_rows};
+const LkKernels ROIFLOW_KERNEL_TABLE = {simd::kNativeName, Native::N,  scratch_floats,
+                                        run_band,          input_rows, upsample_row,
+                                        unit_row_u8,       smooth_h,   smooth_v};
 
 }  // namespace roiflow::flow::detail

@@ -61,7 +61,11 @@ struct BandJob {
   FlowRows output;                       // what the last iteration writes
   float* confidence = nullptr;           // last iteration: per row, or null
   std::ptrdiff_t confidence_stride = 0;  // floats, rows indexed from 0 like `output`
-  const FlowRows* rings = nullptr;       // iterations - 1 intermediate results
+  // Non-null: the last iteration writes (u, v) interleaved here (rows `flow_stride` floats apart,
+  // not padded) instead of into `output`; `confidence` is then not padded either.
+  float* flow = nullptr;
+  std::ptrdiff_t flow_stride = 0;
+  const FlowRows* rings = nullptr;  // iterations - 1 intermediate results
   float* const* scratch = nullptr;  // per iteration: scratch_floats(level) floats, 64-byte aligned
 };
 
@@ -77,7 +81,23 @@ struct LkKernels {
   void (*run_band)(const BandJob& job);
   // The rows iteration 0 reads for final rows [begin, end).
   RowSpan (*input_rows)(const LevelJob& level, int iterations, int begin, int end);
+  // A row of the finer level's flow component upsampled x2 from coarse rows a and b (blended by
+  // fy in {0, 1/2}), n coarse pixels, starting at coarse pixel k0 (between k0 and k0 + 1 when
+  // `between`), `width` long, doubled. temp: upsample_temp_floats(n, lanes) floats.
+  void (*upsample_row)(const float* a, const float* b, float fy, int n, int k0, bool between,
+                       int width, float* temp, float* out);
+  // An 8-bit row as floats in [0, 1].
+  void (*unit_row_u8)(const std::uint8_t* src, int w, float* dst);
+  // The symmetric filter k[0 .. 2 radius] (radius 1..4) of a row padded by `radius` pixels on
+  // each side, and of the 2 radius + 1 rows `rows` at each column.
+  void (*smooth_h)(const float* padded, const float* k, int radius, int w, float* out);
+  void (*smooth_v)(const float* const* rows, const float* k, int radius, int w, float* out);
 };
+
+// Floats of LkKernels::upsample_row's temporary for n coarse pixels.
+inline std::size_t upsample_temp_floats(int n) {
+  return 2 * (static_cast<std::size_t>(n) + 2 + 64) + 64;
+}
 
 // The kernels of the best instruction set this CPU runs. ROIFLOW_SIMD=avx512|avx2|base in the
 // environment picks a lower one (for comparisons); an unavailable one is ignored.

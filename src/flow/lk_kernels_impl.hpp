@@ -321,9 +321,10 @@ struct SolveRow {
   float inv_cy, lambda;
   const float *uo, *vo;
   float *un, *vn, *conf;
+  float* flow;  // non-null: (u, v) interleaved here instead of un, vn (rows not padded)
 };
 
-template <bool kHalf, bool kConfidence>
+template <bool kHalf, bool kConfidence, bool kInterleaved>
 void solve_row_t(const SolveRow& q, int x0, int x1) {
   using S = Native;
   using F = S::F;
@@ -339,7 +340,8 @@ void solve_row_t(const SolveRow& q, int x0, int x1) {
   const int lo = q.lo, hi = q.hi;
   const float* inv_cx = q.inv_cx;
   const float *uo = q.uo, *vo = q.vo;
-  float *un = q.un, *vn = q.vn, *conf = q.conf;
+  float *un = q.un, *vn = q.vn, *conf = q.conf, *flow = q.flow;
+  const int w = q.w;
   const F lambda = S::set1(q.lambda), inv_cy = S::set1(q.inv_cy), half = S::set1(0.5f);
   // Whole vectors: the lanes past w land in the rows' padding.
   for (int x = x0; x < x1; x += S::N) {
@@ -356,24 +358,55 @@ void solve_row_t(const SolveRow& q, int x0, int x1) {
     const F ex = S::madd(s[3], n, S::mul(lambda, S::load(uo + x)));
     const F ey = S::madd(s[4], n, S::mul(lambda, S::load(vo + x)));
     const F inv_det = S::recip(S::nmadd(gxy, gxy, S::mul(a, dd)));
-    S::store(un + x, S::mul(S::nmadd(gxy, ey, S::mul(dd, ex)), inv_det));
-    S::store(vn + x, S::mul(S::nmadd(gxy, ex, S::mul(a, ey)), inv_det));
+    const F nu = S::mul(S::nmadd(gxy, ey, S::mul(dd, ex)), inv_det);
+    const F nv = S::mul(S::nmadd(gxy, ex, S::mul(a, ey)), inv_det);
+    F cf = S::set1(0.f);
     if constexpr (kConfidence) {
       const F hd = S::mul(half, S::sub(gxx, gyy));
       const F root = S::sqrt(S::madd(hd, hd, S::mul(gxy, gxy)));
-      S::store(conf + x, S::max(S::set1(0.f), S::sub(S::mul(half, S::add(gxx, gyy)), root)));
+      cf = S::max(S::set1(0.f), S::sub(S::mul(half, S::add(gxx, gyy)), root));
+    }
+    if constexpr (kInterleaved) {
+      F first, second;
+      S::zip(nu, nv, first, second);
+      if (x + S::N <= w) {
+        S::store(flow + 2 * x, first);
+        S::store(flow + 2 * x + S::N, second);
+        if constexpr (kConfidence) S::store(conf + x, cf);
+      } else {
+        // The rows of the result end at w: the last vector's lanes go one by one.
+        alignas(64) float pairs[2 * S::N], conf_lanes[S::N];
+        S::store(pairs, first);
+        S::store(pairs + S::N, second);
+        S::store(conf_lanes, cf);
+        for (int i = 0; x + i < w; ++i) {
+          flow[2 * (x + i)] = pairs[2 * i];
+          flow[2 * (x + i) + 1] = pairs[2 * i + 1];
+          if constexpr (kConfidence) conf[x + i] = conf_lanes[i];
+        }
+      }
+    } else {
+      S::store(un + x, nu);
+      S::store(vn + x, nv);
+      if constexpr (kConfidence) S::store(conf + x, cf);
     }
   }
 }
 
+template <bool kHalf>
+void solve_row_h(const SolveRow& q, int x0, int x1) {
+  if (q.flow) {
+    if (q.conf) return solve_row_t<kHalf, true, true>(q, x0, x1);
+    return solve_row_t<kHalf, false, true>(q, x0, x1);
+  }
+  if (q.conf) return solve_row_t<kHalf, true, false>(q, x0, x1);
+  solve_row_t<kHalf, false, false>(q, x0, x1);
+}
+
 void solve_row(const SolveRow& q, int x0, int x1) {
   if (x0 >= x1) return;
-  if (q.col) {
-    if (q.conf) return solve_row_t<true, true>(q, x0, x1);
-    return solve_row_t<true, false>(q, x0, x1);
-  }
-  if (q.conf) return solve_row_t<false, true>(q, x0, x1);
-  solve_row_t<false, false>(q, x0, x1);
+  if (q.col) return solve_row_h<true>(q, x0, x1);
+  solve_row_h<false>(q, x0, x1);
 }
 
 using EnterFn = void (*)(int, int, const TermRows&, float, float*, float*, const float*, float*,

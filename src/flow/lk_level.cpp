@@ -88,42 +88,24 @@ int padded_width(int w) {
 namespace {
 
 // Row y (of the finer rectangle `dst`) of the coarser flow component `src` (origin `origin` in
-// its level), upsampled and doubled: pixel x of the finer level sits at x / 2 of the coarser one,
-// so along each axis the finer pixels alternate between copies of a coarse pixel and means of
-// two neighbours; borders replicate. `copy`, `mean`: src.cols + 2 floats each.
-void upsample_row(const cv::Mat& src, cv::Point origin, const cv::Rect& dst, int y, float* copy,
-                  float* mean, float* out) {
-  const int n = src.cols;
+// its level), upsampled x2 and doubled (LkKernels::upsample_row). `temp`:
+// upsample_temp_floats(src.cols) floats.
+void upsample_row(const LkKernels& k, const cv::Mat& src, cv::Point origin, const cv::Rect& dst,
+                  int y, float* temp, float* out) {
   const int twice_x = dst.x - 2 * origin.x;
-  const int k0 = twice_x >> 1;
-  const bool x_between = (twice_x & 1) != 0;
   const int twice_y = dst.y + y - 2 * origin.y;
   const int y0 = std::clamp(twice_y >> 1, 0, src.rows - 1);
   const int y1 = std::min(y0 + 1, src.rows - 1);
-  const float fy = (twice_y & 1) ? 0.5f : 0.f;
-  const float* a = src.ptr<float>(y0);
-  const float* b = src.ptr<float>(y1);
-  for (int x = 0; x < n; ++x)
-    copy[x] = 2.f * (a[x] + fy * (b[x] - a[x]));
-  copy[n] = copy[n + 1] = copy[n - 1];
-  for (int x = 0; x <= n; ++x)
-    mean[x] = 0.5f * (copy[x] + copy[x + 1]);
-  const float* first = x_between ? mean + k0 : copy + k0;
-  const float* second = x_between ? copy + k0 + 1 : mean + k0;
-  const int pairs = dst.width / 2;
-  for (int i = 0; i < pairs; ++i) {
-    out[2 * i] = first[i];
-    out[2 * i + 1] = second[i];
-  }
-  if (dst.width & 1) out[dst.width - 1] = first[pairs];
+  k.upsample_row(src.ptr<float>(y0), src.ptr<float>(y1), (twice_y & 1) ? 0.5f : 0.f, src.cols,
+                 twice_x >> 1, (twice_x & 1) != 0, dst.width, temp, out);
 }
 
 // Rows [first, first + count) of the level's starting flow into u, v (rows `stride` apart, row
 // `first` at the start), with column w replicated into column w.
-void fill_input(const LevelInput& in, const cv::Rect& comp, int first, int count, float* u,
-                float* v, std::ptrdiff_t stride, std::vector<float>& temp) {
+void fill_input(const LkKernels& k, const LevelInput& in, const cv::Rect& comp, int first,
+                int count, float* u, float* v, std::ptrdiff_t stride, std::vector<float>& temp) {
   const int w = comp.width;
-  if (in.kind == LevelInput::Kind::Coarser) temp.resize(2 * (in.pu->cols + 2));
+  if (in.kind == LevelInput::Kind::Coarser) temp.resize(upsample_temp_floats(in.pu->cols));
   for (int i = 0; i < count; ++i) {
     float* ur = u + i * stride;
     float* vr = v + i * stride;
@@ -137,13 +119,10 @@ void fill_input(const LevelInput& in, const cv::Rect& comp, int first, int count
         std::copy_n(in.pu->ptr<float>(y), w, ur);
         std::copy_n(in.pv->ptr<float>(y), w, vr);
         break;
-      case LevelInput::Kind::Coarser: {
-        float* copy = temp.data();
-        float* mean = copy + in.pu->cols + 2;
-        upsample_row(*in.pu, in.coarse_origin, comp, y, copy, mean, ur);
-        upsample_row(*in.pv, in.coarse_origin, comp, y, copy, mean, vr);
+      case LevelInput::Kind::Coarser:
+        upsample_row(k, *in.pu, in.coarse_origin, comp, y, temp.data(), ur);
+        upsample_row(k, *in.pv, in.coarse_origin, comp, y, temp.data(), vr);
         break;
-      }
     }
     ur[w] = ur[w - 1];
     vr[w] = vr[w - 1];
@@ -176,12 +155,17 @@ int ring_rows(const LevelJob& L) {
 
 void iterate_level(const LevelProblem& p, const LevelInput& input, cv::Mat& u, cv::Mat& v,
                    cv::Mat* confidence, int iterations, const Executor& executor,
-                   LevelScratch& scratch) {
+                   LevelScratch& scratch, cv::Mat* flow) {
   const cv::Rect& c = p.comp;
   const int wp = padded_width(c.width);
-  u.create(c.height, wp, CV_32F);
-  v.create(c.height, wp, CV_32F);
-  if (confidence) confidence->create(c.height, wp, CV_32F);
+  if (flow) {
+    flow->create(c.size(), CV_32FC2);
+    if (confidence) confidence->create(c.size(), CV_32F);
+  } else {
+    u.create(c.height, wp, CV_32F);
+    v.create(c.height, wp, CV_32F);
+    if (confidence) confidence->create(c.height, wp, CV_32F);
+  }
 
   // Windows are clipped at the computed rectangle; near the image border that is the
   // image border, elsewhere only pixels outside the wanted region are affected.
@@ -241,7 +225,8 @@ void iterate_level(const LevelProblem& p, const LevelInput& input, cv::Mat& u, c
     const BandPlan& bp = plans[b];
     std::vector<float> temp;
     const std::ptrdiff_t count = bp.span.count;
-    fill_input(input, c, bp.span.first, bp.span.count, bp.input, bp.input + count * wp, wp, temp);
+    fill_input(k, input, c, bp.span.first, bp.span.count, bp.input, bp.input + count * wp, wp,
+               temp);
     std::vector<FlowRows> rings(std::max(0, iterations - 1));
     std::vector<float*> rows(iterations);
     for (int i = 0; i + 1 < iterations; ++i) {
@@ -256,9 +241,12 @@ void iterate_level(const LevelProblem& p, const LevelInput& input, cv::Mat& u, c
     job.begin = starts[b];
     job.end = starts[b + 1];
     job.input = FlowRows{bp.input, bp.input + count * wp, wp, -1, bp.span.first};
-    job.output = FlowRows{u.ptr<float>(), v.ptr<float>(), wp, -1, 0};
+    job.output = flow ? FlowRows{} : FlowRows{u.ptr<float>(), v.ptr<float>(), wp, -1, 0};
     job.confidence = confidence ? confidence->ptr<float>() : nullptr;
-    job.confidence_stride = wp;
+    job.confidence_stride =
+        confidence ? static_cast<std::ptrdiff_t>(confidence->step1()) : std::ptrdiff_t{0};
+    job.flow = flow ? flow->ptr<float>() : nullptr;
+    job.flow_stride = flow ? static_cast<std::ptrdiff_t>(flow->step1()) : std::ptrdiff_t{0};
     job.rings = rings.data();
     job.scratch = rows.data();
     k.run_band(job);
@@ -275,9 +263,10 @@ void iterate_level(const LevelProblem& p, const LevelInput& input, cv::Mat& u, c
 
 void upsample_flow(const cv::Mat& src, cv::Point src_origin, const cv::Rect& dst, cv::Mat& out) {
   out.create(dst.size(), CV_32F);
-  std::vector<float> copy(src.cols + 2), mean(src.cols + 2);
+  const LkKernels& k = lk_kernels();
+  std::vector<float> temp(upsample_temp_floats(src.cols));
   for (int y = 0; y < dst.height; ++y)
-    upsample_row(src, src_origin, dst, y, copy.data(), mean.data(), out.ptr<float>(y));
+    upsample_row(k, src, src_origin, dst, y, temp.data(), out.ptr<float>(y));
 }
 
 }  // namespace roiflow::flow::detail

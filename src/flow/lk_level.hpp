@@ -82,13 +82,14 @@ struct LevelScratch {
 int padded_width(int w);
 
 // `iterations` refinement passes over the level from `input`, into u and v (CV_32F planes of
-// rows padded_width(comp.width) long: create them with that many columns and view the first
-// comp.width) and, when not null, the smallest eigenvalue of each window's structure tensor
-// into `confidence` (the same shape). Row bands run on the executor; the result is the same
-// for any split.
+// comp.height rows padded_width(comp.width) long, created here: view the first comp.width
+// columns) and, when not null, the smallest eigenvalue of each window's structure tensor into
+// `confidence` (the same shape). With `flow` (CV_32FC2, comp-sized), the flow goes there
+// interleaved instead, u and v are left alone, and `confidence` is comp-sized too. Row bands
+// run on the executor; the result is the same for any split.
 void iterate_level(const LevelProblem& p, const LevelInput& input, cv::Mat& u, cv::Mat& v,
                    cv::Mat* confidence, int iterations, const Executor& executor,
-                   LevelScratch& scratch);
+                   LevelScratch& scratch, cv::Mat* flow = nullptr);
 
 // Flow component of the coarser level (origin `src_origin` in its level) resampled onto
 // rectangle `dst` of the finer level and doubled.

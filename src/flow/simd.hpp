@@ -148,6 +148,11 @@ struct Scalar {
   ROIFLOW_INLINE static F load_u8(const std::uint8_t* p) {
     return static_cast<F>(*p);
   }
+  // Interleaves a and b: lo = (a0, b0, a1, b1, ...) over the first half of the lanes, hi the rest.
+  ROIFLOW_INLINE static void zip(F a, F b, F& lo, F& hi) {
+    lo = a;
+    hi = b;
+  }
 };
 
 #if defined(ROIFLOW_SIMD_AVX512)
@@ -215,6 +220,13 @@ struct Native {
     return _mm512_cvtepi32_ps(
         _mm512_cvtepu8_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p))));
   }
+  ROIFLOW_INLINE static void zip(F a, F b, F& lo, F& hi) {
+    const __m512i l = _mm512_setr_epi32(0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, 23);
+    const __m512i h =
+        _mm512_setr_epi32(8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31);
+    lo = _mm512_permutex2var_ps(a, l, b);
+    hi = _mm512_permutex2var_ps(a, h, b);
+  }
 };
 #elif defined(ROIFLOW_SIMD_AVX2)
 struct Native {
@@ -273,6 +285,11 @@ struct Native {
   ROIFLOW_INLINE static F load_u8(const std::uint8_t* p) {
     return _mm256_cvtepi32_ps(
         _mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p))));
+  }
+  ROIFLOW_INLINE static void zip(F a, F b, F& lo, F& hi) {
+    const F l = _mm256_unpacklo_ps(a, b), h = _mm256_unpackhi_ps(a, b);
+    lo = _mm256_permute2f128_ps(l, h, 0x20);
+    hi = _mm256_permute2f128_ps(l, h, 0x31);
   }
 };
 #elif defined(ROIFLOW_SIMD_SSE2)
@@ -336,6 +353,10 @@ struct Native {
     const __m128i b = _mm_unpacklo_epi8(_mm_cvtsi32_si128(word), zero);
     return _mm_cvtepi32_ps(_mm_unpacklo_epi16(b, zero));
   }
+  ROIFLOW_INLINE static void zip(F a, F b, F& lo, F& hi) {
+    lo = _mm_unpacklo_ps(a, b);
+    hi = _mm_unpackhi_ps(a, b);
+  }
 };
 #elif defined(ROIFLOW_SIMD_NEON)
 struct Native {
@@ -396,6 +417,10 @@ struct Native {
     std::memcpy(&word, p, 4);
     const uint8x8_t b = vcreate_u8(word);
     return vcvtq_f32_u32(vmovl_u16(vget_low_u16(vmovl_u8(b))));
+  }
+  ROIFLOW_INLINE static void zip(F a, F b, F& lo, F& hi) {
+    lo = vzip1q_f32(a, b);
+    hi = vzip2q_f32(a, b);
   }
 };
 #else
