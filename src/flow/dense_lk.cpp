@@ -268,6 +268,13 @@ void DenseLK::set_params(const LkParams& params) {
   params_ = params;
 }
 
+void DenseLK::reserve(cv::Size size, const FlowOptions& options) {
+  // A pair of black frames takes every buffer a pair of this size takes.
+  const cv::Mat black = cv::Mat::zeros(size, CV_8UC1);
+  FlowResult ignored;
+  calc(black, black, ignored, options);
+}
+
 void DenseLK::collectGarbage() {
   ws_.reset();
 }

@@ -99,6 +99,12 @@ TEST(DenseLkObjectTest, CollectGarbageFreesTheWorkspaceAndTheNextCallRebuildsIt)
   EXPECT_EQ(lk.workspace_bytes(), 0u);
   EXPECT_EQ(max_abs_diff(lk.calc(s.frame0, s.frame1).flow, first.flow), 0.0);
   EXPECT_EQ(lk.workspace_bytes(), held);
+  // reserve() takes what a pair of that size takes, and the pair then takes nothing more.
+  DenseLK reserved(LkParams::paper());
+  reserved.reserve(kSize);
+  EXPECT_EQ(reserved.workspace_bytes(), held);
+  EXPECT_EQ(max_abs_diff(reserved.calc(s.frame0, s.frame1).flow, first.flow), 0.0);
+  EXPECT_EQ(reserved.workspace_bytes(), held);
   // A moved-from object holds nothing; the moved-to one goes on.
   DenseLK moved = std::move(lk);
   EXPECT_EQ(moved.workspace_bytes(), held);
