@@ -279,6 +279,15 @@ void iteration_rows(const LevelJob& L, int iterations, int begin, int end, int* 
   }
 }
 
+int band_rows(const LevelJob& L, int iterations, int begin, int end) {
+  int first[kMaxIterations], last[kMaxIterations];
+  iteration_rows(L, iterations, begin, end, first, last);
+  int rows = 0;
+  for (int k = 0; k < iterations; ++k)
+    rows += last[k] - first[k];
+  return rows;
+}
+
 RowSpan input_rows(const LevelJob& L, int iterations, int begin, int end) {
   int first[kMaxIterations], last[kMaxIterations];
   iteration_rows(L, iterations, begin, end, first, last);
@@ -319,8 +328,8 @@ void run_band(const BandJob& job) {
 }  // namespace
 
 extern const LkKernels ROIFLOW_KERNEL_TABLE;
-const LkKernels ROIFLOW_KERNEL_TABLE = {simd::kNativeName, Native::N,  scratch_floats,
-                                        run_band,          input_rows, upsample_row,
-                                        unit_row_u8,       smooth_h,   smooth_v};
+const LkKernels ROIFLOW_KERNEL_TABLE = {simd::kNativeName, Native::N, scratch_floats, run_band,
+                                        input_rows,        band_rows, upsample_row,   unit_row_u8,
+                                        smooth_h,          smooth_v};
 
 }  // namespace roiflow::flow::detail

@@ -81,6 +81,8 @@ struct LkKernels {
   void (*run_band)(const BandJob& job);
   // The rows iteration 0 reads for final rows [begin, end).
   RowSpan (*input_rows)(const LevelJob& level, int iterations, int begin, int end);
+  // The rows all iterations of run_band compute for final rows [begin, end), added up.
+  int (*band_rows)(const LevelJob& level, int iterations, int begin, int end);
   // A row of the finer level's flow component upsampled x2 from coarse rows a and b (blended by
   // fy in {0, 1/2}), n coarse pixels, starting at coarse pixel k0 (between k0 and k0 + 1 when
   // `between`), `width` long, doubled. temp: upsample_temp_floats(n, lanes) floats.

@@ -129,13 +129,28 @@ void fill_input(const LkKernels& k, const LevelInput& in, const cv::Rect& comp, 
   }
 }
 
-// Final rows of each band: `bands` of about equal work, each starting on a stripe row.
-std::vector<int> band_starts(int h, int wanted) {
-  std::vector<int> starts{0};
+// Final rows of each band, each starting on a stripe row. A band below the first recomputes the
+// rows its earlier iterations read above it: two bands are split where their work (rows times
+// iterations) is the most even; more bands about equally.
+std::vector<int> band_starts(const LkKernels& k, const LevelJob& L, int iterations, int wanted) {
+  const int h = L.h;
   const int bands = std::clamp(h / kMinBandRows, 1, std::max(1, wanted));
-  for (int b = 1; b < bands; ++b) {
-    const int s = (h * b / bands) / kStripeRows * kStripeRows;
-    if (s > starts.back()) starts.push_back(s);
+  std::vector<int> starts{0};
+  if (bands == 2) {
+    int best = 0, best_work = 0;
+    for (int s = kStripeRows; s < h; s += kStripeRows) {
+      const int work = std::max(k.band_rows(L, iterations, 0, s), k.band_rows(L, iterations, s, h));
+      if (best == 0 || work < best_work) {
+        best = s;
+        best_work = work;
+      }
+    }
+    if (best > 0) starts.push_back(best);
+  } else {
+    for (int b = 1; b < bands; ++b) {
+      const int s = (h * b / bands) / kStripeRows * kStripeRows;
+      if (s > starts.back()) starts.push_back(s);
+    }
   }
   starts.push_back(h);
   return starts;
@@ -199,7 +214,7 @@ void iterate_level(const LevelProblem& p, const LevelInput& input, cv::Mat& u, c
   L.stripe = kStripeRows;
 
   const LkKernels& k = lk_kernels();
-  const std::vector<int> starts = band_starts(c.height, executor.concurrency());
+  const std::vector<int> starts = band_starts(k, L, iterations, executor.concurrency());
   const int bands = static_cast<int>(starts.size()) - 1;
   if (static_cast<int>(scratch.bands.size()) < bands) scratch.bands.resize(bands);
   const int q = ring_rows(L);
