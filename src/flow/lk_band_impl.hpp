@@ -59,7 +59,7 @@ std::size_t scratch_floats(const LevelJob& L) {
 // Columns per step of a row pass: every stage (warp, pairs, window terms and sums, prefix sums,
 // solve) runs over one chunk before the next, so that a row's intermediate data stays in the
 // first-level cache; only the ring and the vertical sums come from further away.
-constexpr int kChunk = 128;
+constexpr int kChunk = 256;
 
 // One iteration of one band: rows [first, end) of its output from its input.
 class RowPass {
