@@ -7,7 +7,7 @@
 
 #include "core/error.hpp"
 #include "flow/large_motion.hpp"
-#include "flow/lk_rows.hpp"
+#include "flow/window_cost.hpp"
 
 namespace roiflow::flow {
 
@@ -35,7 +35,6 @@ class CandidatePass {
     c2_.assign(w_ + 2 * r_, 0.f);
     cu_.resize(w_);
     cv_.resize(w_);
-    mean_.resize(w_);
     inv_ny_.resize(h_);
     inv_nx_.resize(w_);
     for (int y = 0; y < h_; ++y)
@@ -107,7 +106,7 @@ class CandidatePass {
     shifted_row(u0, y, ox, oy, cu_.data());
     shifted_row(v0, y, ox, oy, cv_.data());
     float* __restrict d = ring_row(y);
-    detail::warp_row(i1_, i0_.ptr<float>(y), 0, y, w_, cu_.data(), cv_.data(), mean_.data(), d);
+    detail::warp_difference_row(i1_, i0_.ptr<float>(y), y, w_, cu_.data(), cv_.data(), d);
     float* __restrict c1 = c1_.data() + r_;
     float* __restrict c2 = c2_.data() + r_;
     for (int x = 0; x < w_; ++x) {
@@ -129,7 +128,7 @@ class CandidatePass {
   const cv::Mat& i0_;
   const cv::Mat& i1_;
   int w_, h_, r_;
-  std::vector<float> ring_, c1_, c2_, cu_, cv_, mean_, inv_ny_, inv_nx_;
+  std::vector<float> ring_, c1_, c2_, cu_, cv_, inv_ny_, inv_nx_;
 };
 
 }  // namespace

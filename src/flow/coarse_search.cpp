@@ -325,6 +325,12 @@ int requested_levels(cv::Size size, const LkParams& params) {
                            : auto_levels(size, params.expected_motion, params.coarsest_side);
 }
 
+bool seeds_level(const LkParams& params, int level, int levels, const FlowOptions& options) {
+  return (level == levels - 1 && params.search_radius > 0 && options.initial_flow.empty()) ||
+         (params.fuse_far_step > 0 && level >= params.fuse_far_finest_level) ||
+         (params.fuse_step > 0 && level >= params.fuse_finest_level);
+}
+
 void seed_level(const LkParams& params, const cv::Mat& i0, const cv::Mat& i1, const cv::Rect& c,
                 int level, int levels, const FlowOptions& options, cv::Mat& u, cv::Mat& v) {
   // A region works on its own rectangle, read as if the frame ended there.
@@ -341,19 +347,6 @@ void seed_level(const LkParams& params, const cv::Mat& i0, const cv::Mat& i1, co
     fuse_candidates(a, b, params.fuse_far_step, kFuseWindow, u, v);
   if (params.fuse_step > 0 && level >= params.fuse_finest_level)
     fuse_candidates(a, b, params.fuse_step, kFuseWindow, u, v);
-}
-
-void mask_outside_row(const cv::Mat& i1, const float* __restrict i0, int x0, int y, int w,
-                      const float* __restrict u, const float* __restrict v, float* __restrict m,
-                      float* __restrict d) {
-  const float xhi = static_cast<float>(i1.cols - 1), yhi = static_cast<float>(i1.rows - 1);
-  const float fy = static_cast<float>(y);
-  for (int x = 0; x < w; ++x) {
-    const float sx = static_cast<float>(x0 + x) + u[x], sy = fy + v[x];
-    const bool outside = sx < 0.f || sx > xhi || sy < 0.f || sy > yhi;
-    m[x] = outside ? i0[x] : m[x];
-    d[x] = outside ? 0.f : d[x];
-  }
 }
 
 }  // namespace detail

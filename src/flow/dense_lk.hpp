@@ -158,6 +158,9 @@ class DenseLK {
   const Executor* executor() const { return executor_; }
   void set_executor(const Executor* executor) { executor_ = executor; }
 
+  // Allocates (and touches) the workspace for frames of `size` now, so that the next calc of that
+  // size allocates nothing: timing a single pair then measures the flow, not the page faults.
+  void reserve(cv::Size size, const FlowOptions& options = {});
   // Frees the workspace now (the next calc allocates it again), as
   // cv::DenseOpticalFlow::collectGarbage does.
   void collectGarbage();

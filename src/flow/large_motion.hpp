@@ -75,6 +75,9 @@ namespace detail {
 // The levels `params` asks for at frame size `size`: params.levels, or auto_levels when it is 0.
 int requested_levels(cv::Size size, const LkParams& params);
 
+// Whether seed_level does anything at level `level` of `levels` for `params` and `options`.
+bool seeds_level(const LkParams& params, int level, int levels, const FlowOptions& options);
+
 // dense_flow's hook before the iterations of level `level` (of `levels`; i0, i1: its whole
 // images), on the rectangle `c` that u and v cover: the coarse search at the coarsest level
 // (around options.initial_motion; not when options.initial_flow gives the start), then the far
@@ -82,13 +85,6 @@ int requested_levels(cv::Size size, const LkParams& params);
 // rectangle.
 void seed_level(const LkParams& params, const cv::Mat& i0, const cv::Mat& i1, const cv::Rect& c,
                 int level, int levels, const FlowOptions& options, cv::Mat& u, cv::Mat& v);
-
-// With LkParams::mask_outside: the pixels of one warped row whose sample of frame t+1 fell
-// outside the frame (x0 + x + u[x], y + v[x] beyond the level `i1`) get It = 0 (d[x] = 0) and
-// the gradient of frame t alone (m[x] = i0[x]). They then ask LK for no change of flow instead
-// of pulling it towards the replicated border.
-void mask_outside_row(const cv::Mat& i1, const float* i0, int x0, int y, int w, const float* u,
-                      const float* v, float* m, float* d);
 
 }  // namespace detail
 

@@ -5,8 +5,6 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "flow/lk_rows.hpp"
-
 namespace roiflow::flow::detail {
 
 BoxSum::BoxSum(int w, int h, int r) : w_(w), h_(h), r_(r) {}
@@ -51,15 +49,38 @@ void ZssdWindow::operator()(const float* d, float* cost) {
     cost[i] = s2[i] - s1[i] * s1[i] * inv[i];
 }
 
+void warp_difference_row(const cv::Mat& i1, const float* __restrict i0, int y, int w,
+                         const float* __restrict u, const float* __restrict v,
+                         float* __restrict d) {
+  const float xhi = static_cast<float>(i1.cols - 1), yhi = static_cast<float>(i1.rows - 1);
+  const int ixmax = std::max(0, i1.cols - 2), iymax = std::max(0, i1.rows - 2);
+  const int dx1 = i1.cols > 1 ? 1 : 0;
+  const std::ptrdiff_t step = static_cast<std::ptrdiff_t>(i1.step1());
+  const std::ptrdiff_t dy1 = i1.rows > 1 ? step : 0;
+  const float* __restrict base = i1.ptr<float>(0);
+  const float fy0 = static_cast<float>(y);
+  for (int x = 0; x < w; ++x) {
+    const float sx = std::min(std::max(static_cast<float>(x) + u[x], 0.f), xhi);
+    const float sy = std::min(std::max(fy0 + v[x], 0.f), yhi);
+    const int ix = std::min(static_cast<int>(sx), ixmax);
+    const int iy = std::min(static_cast<int>(sy), iymax);
+    const float fx = sx - static_cast<float>(ix), fy = sy - static_cast<float>(iy);
+    const float* p = base + iy * step + ix;
+    const float top = p[0] + fx * (p[dx1] - p[0]);
+    const float bot = p[dy1] + fx * (p[dy1 + dx1] - p[dy1]);
+    d[x] = top + fy * (bot - top) - i0[x];
+  }
+}
+
 FieldCost::FieldCost(int w, int h, int window)
-    : zssd_(w, h, window), d_(static_cast<std::size_t>(w) * h), mean_(w) {}
+    : zssd_(w, h, window), d_(static_cast<std::size_t>(w) * h) {}
 
 void FieldCost::operator()(const cv::Mat& i0, const cv::Mat& i1, const cv::Mat& u, const cv::Mat& v,
                            std::vector<float>& cost) {
   const int w = i0.cols;
   for (int y = 0; y < i0.rows; ++y) {
-    warp_row(i1, i0.ptr<float>(y), 0, y, w, u.ptr<float>(y), v.ptr<float>(y), mean_.data(),
-             d_.data() + static_cast<std::size_t>(y) * w);
+    warp_difference_row(i1, i0.ptr<float>(y), y, w, u.ptr<float>(y), v.ptr<float>(y),
+                        d_.data() + static_cast<std::size_t>(y) * w);
   }
   cost.resize(d_.size());
   zssd_(d_.data(), cost.data());

@@ -38,6 +38,11 @@ class ZssdWindow {
   std::vector<float> inv_count_, squares_, s1_, s2_;
 };
 
+// Row y of d = I1(x + u[x], y + v[x]) - i0[x], x < w: frame t+1 (`i1`, CV_32FC1) sampled
+// bilinearly, coordinates clamped to the frame (its border replicated).
+void warp_difference_row(const cv::Mat& i1, const float* i0, int y, int w, const float* u,
+                         const float* v, float* d);
+
 // The zero-mean SSD of every pixel's window when the whole candidate field (u, v) (level
 // pixels, i0's size) carries frame t+1 (bilinear, borders replicated) onto frame t `i0`: a
 // pixel's cost also says how well the field fits its neighbours, so choosing per pixel between
@@ -50,7 +55,7 @@ class FieldCost {
 
  private:
   ZssdWindow zssd_;
-  std::vector<float> d_, mean_;
+  std::vector<float> d_;
 };
 
 }  // namespace roiflow::flow::detail

@@ -169,11 +169,11 @@ TEST(DenseLkTest, TinyImagesGiveFiniteFlowOfTheRightSize) {
       EXPECT_TRUE(all_finite(moved.confidence)) << c.name << " " << size;
 
       // Not exactly zero: the warp interpolates the last column and row with weight 1 on the
-      // far sample, p00 + 1 * (p01 - p00), which can miss p01 by an ulp (measured up to
-      // 1.5e-8 px, at 13x13 with Scharr).
+      // far sample, p00 + 1 * (p01 - p00), which can miss p01 by an ulp, and in a window of a
+      // few pixels lambda barely damps it (measured up to 1.7e-7 px, at 2x2 with Scharr).
       const FlowResult still = dense_flow(a, a, c.params);
       ASSERT_EQ(still.flow.size(), size);
-      EXPECT_LT(cv::norm(still.flow, cv::NORM_INF), 1e-7) << c.name << " " << size;
+      EXPECT_LT(cv::norm(still.flow, cv::NORM_INF), 1e-6) << c.name << " " << size;
     }
   }
 }

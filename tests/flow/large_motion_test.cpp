@@ -164,24 +164,27 @@ TEST(CandidateFusionTest, FlatFramesKeepEveryPixelsOwnFlow) {
   EXPECT_EQ(cv::norm(v, v0, cv::NORM_INF), 0.0);
 }
 
-TEST(MaskOutsideTest, OnlySamplesBeyondTheFrameAreNeutral) {
-  const cv::Mat i1 = texture({10, 6}, 8), i0 = texture({10, 6}, 9);
-  const float* row0 = i0.ptr<float>(2);
-  // x0 = 1: pixels 1..8 of row 2; u sends pixel 1 to -0.5 and pixel 8 to 9.5 (outside),
-  // v sends pixel 4 to y = 5.5 (outside); the others stay inside.
-  const float u[8] = {-1.5f, 0.f, 0.f, 0.f, 0.f, 0.f, 0.f, 1.5f};
-  const float v[8] = {0.f, 0.f, 0.f, 3.5f, 0.f, 0.f, 0.f, 0.f};
-  float m[8], d[8];
-  for (int i = 0; i < 8; ++i) {
-    m[i] = 10.f + static_cast<float>(i);
-    d[i] = 20.f + static_cast<float>(i);
-  }
-  detail::mask_outside_row(i1, row0 + 1, 1, 2, 8, u, v, m, d);
-  for (int i = 0; i < 8; ++i) {
-    const bool outside = i == 0 || i == 3 || i == 7;
-    EXPECT_EQ(m[i], outside ? row0[1 + i] : 10.f + static_cast<float>(i)) << i;
-    EXPECT_EQ(d[i], outside ? 0.f : 20.f + static_cast<float>(i)) << i;
-  }
+// A pixel whose sample of frame t+1 leaves the frame has no brightness term: with
+// mask_outside it keeps the flow it came with instead of being pulled to the replicated border.
+TEST(MaskOutsideTest, PixelsLeavingTheFrameKeepTheirFlow) {
+  const cv::Mat i0 = texture({160, 120}, 13, 2.0);
+  const cv::Point2f motion(6.f, 0.f);
+  const cv::Mat frame0 = to8u(i0), frame1 = to8u(moved(i0, motion));
+  LkParams params = LkParams::paper();
+  params.iterations = 8;
+  FlowOptions options;
+  options.initial_motion = motion;  // the right answer from the start
+  const cv::Mat truth(i0.size(), CV_32FC2, cv::Scalar(motion.x, motion.y));
+  cv::Mat not_edge(i0.size(), CV_8UC1, cv::Scalar(0));  // the last 6 columns leave the frame
+  not_edge(cv::Rect(0, 0, 154, 120)).setTo(255);
+  const FlowErrors pulled =
+      flow_errors(dense_flow(frame0, frame1, params, options).flow, truth, not_edge);
+  params.mask_outside = true;
+  const FlowErrors kept =
+      flow_errors(dense_flow(frame0, frame1, params, options).flow, truth, not_edge);
+  // Measured: 4.21 px pulled, 0.003 px kept.
+  EXPECT_GT(pulled.epe, 2.0);
+  EXPECT_LT(kept.epe, 0.01);
 }
 
 // dense_flow end to end: a 40 px translation of a 320x240 texture is ten patches away. The
