@@ -199,8 +199,8 @@ TEST(LargeMotionTest, PresetsWithTheSearchFollowAFortyPixelTranslation) {
   const FlowErrors paper =
       flow_errors(dense_flow(frame0, frame1, LkParams::paper()).flow, truth, inside);
   EXPECT_GT(paper.epe, 10.0);  // measured 42.4 px
-  // Measured: accurate < 1e-4 px, fast 0.0098 px (LK stops at level 1 and is upsampled).
-  const std::pair<const char*, double> presets[] = {{"accurate", 0.005}, {"fast", 0.05}};
+  // Measured: accurate < 1e-4 px, fast 0.100 px (LK stops at level 2 and is upsampled x4).
+  const std::pair<const char*, double> presets[] = {{"accurate", 0.005}, {"fast", 0.15}};
   for (const auto& [name, bound] : presets) {
     const FlowResult r = dense_flow(frame0, frame1, LkParams::preset(name));
     ASSERT_EQ(r.flow.size(), i0.size());
