@@ -37,7 +37,8 @@ LkParams LkParams::accurate() {
 
 // The realtime choice for large motions, set as DIS ULTRAFAST is: the search on a coarser level
 // (shorter side 20 px), LK from there down to level 2 (a quarter of the resolution) and the
-// flow upsampled; one candidate-fusion pass, on the coarse levels only.
+// flow upsampled. No candidate fusion: at these levels it traded KITTI against Sintel and cost
+// a sixth of the time (docs/ACCURACY.md).
 LkParams LkParams::fast() {
   LkParams p;
   p.levels = 0;
@@ -46,8 +47,6 @@ LkParams LkParams::fast() {
   p.robust_scale = 0.008;
   p.final_median = 3;
   p.search_radius = 8;
-  p.fuse_step = 12;
-  p.fuse_finest_level = 3;
   p.mask_outside = true;
   p.finest_level = 2;
   return p;
