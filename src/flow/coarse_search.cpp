@@ -52,138 +52,13 @@ cv::Mat padded(const cv::Mat& b, int pad) {
   return out;
 }
 
-// The zero-mean SSD of every window of `a` at one displacement, fused in one pass over the rows
-// (the search runs this for every displacement, so it must not allocate or call out): running
-// column sums of d and d^2 over the window's rows (rows enter and leave; zero columns outside
-// `a` make the window clipped, as the counts in inv_n), a direct sum of the window's columns,
-// the cost, and the running best.
-class DisplacementPass {
- public:
-  DisplacementPass(const cv::Mat& a, int window) : a_(a), r_(window / 2) {
-    const int w = a.cols, h = a.rows;
-    c1_.assign(w + 2 * r_, 0.f);
-    c2_.assign(w + 2 * r_, 0.f);
-    s1_.resize(w);
-    s2_.resize(w);
-    ring1_.resize(static_cast<std::size_t>(2 * r_ + 1) * w);
-    ring2_.resize(ring1_.size());
-    inv_nx_.resize(w);
-    inv_ny_.resize(h);
-    for (int x = 0; x < w; ++x)
-      inv_nx_[x] = 1.f / static_cast<float>(std::min(w - 1, x + r_) - std::max(0, x - r_) + 1);
-    for (int y = 0; y < h; ++y)
-      inv_ny_[y] = 1.f / static_cast<float>(std::min(h - 1, y + r_) - std::max(0, y - r_) + 1);
-  }
-
-  // Displacement (du, dv) into `b_padded` (pad pixels each side): updates m where it is better;
-  // the costs into `costs` when it is not null.
-  void run(const cv::Mat& b_padded, int pad, int du, int dv, Matches& m, float* costs) {
-    const int w = a_.cols, h = a_.rows, r = r_;
-    std::fill(c1_.begin(), c1_.end(), 0.f);
-    std::fill(c2_.begin(), c2_.end(), 0.f);
-    for (int y = 0; y < std::min(r, h); ++y)
-      enter(b_padded, pad, du, dv, y);
-    const auto iu = static_cast<std::int32_t>(du), iv = static_cast<std::int32_t>(dv);
-    for (int y = 0; y < h; ++y) {
-      // The leaving row's ring slot is the entering row's: leave first.
-      if (y - r - 1 >= 0) leave(y - r - 1);
-      if (y + r < h) enter(b_padded, pad, du, dv, y + r);
-      const std::size_t row = static_cast<std::size_t>(y) * w;
-      float* cost = costs ? costs + row : s1_.data();
-      if (r == 3) {
-        select_row<3>(row, inv_ny_[y], iu, iv, m, cost);
-      } else {
-        select_row<-1>(row, inv_ny_[y], iu, iv, m, cost);
-      }
-    }
-  }
-
- private:
-  // The window sums of one row from the column sums, the cost, and the running best: one loop
-  // along x. With the radius known at compile time (kR >= 0) the taps unroll and the loop
-  // vectorises along x.
-  template <int kR>
-  void select_row(std::size_t row, float iny, std::int32_t iu, std::int32_t iv, Matches& m,
-                  float* __restrict cost) {
-    const int w = a_.cols, r = kR >= 0 ? kR : r_;
-    const float* __restrict c1 = c1_.data();
-    const float* __restrict c2 = c2_.data();
-    const float* __restrict inx = inv_nx_.data();
-    float* __restrict best = m.cost.data() + row;
-    std::int32_t* __restrict bu = m.du.data() + row;
-    std::int32_t* __restrict bv = m.dv.data() + row;
-    for (int x = 0; x < w; ++x) {
-      float s1 = 0.f, s2 = 0.f;
-#pragma GCC unroll 16
-      for (int k = 0; k <= 2 * r; ++k) {
-        s1 += c1[x + k];
-        s2 += c2[x + k];
-      }
-      const float c = s2 - s1 * s1 * (inx[x] * iny);
-      cost[x] = c;
-      const bool better = c < best[x];
-      best[x] = better ? c : best[x];
-      bu[x] = better ? iu : bu[x];
-      bv[x] = better ? iv : bv[x];
-    }
-    // The same costs as the backward search's at the targets t = x + (iu, iv) in the frame.
-    const int y = static_cast<int>(row / static_cast<std::size_t>(w)), ty = y + iv;
-    if (ty < 0 || ty >= a_.rows) return;
-    const int x0 = std::max(0, -iu), x1 = std::min(w, w - iu);
-    const std::size_t trow = static_cast<std::size_t>(ty) * w + iu;  // + x: the target
-    float* __restrict tb = m.back_cost.data() + trow;
-    std::int32_t* __restrict tu = m.back_du.data() + trow;
-    std::int32_t* __restrict tv = m.back_dv.data() + trow;
-    for (int x = x0; x < x1; ++x) {
-      const bool better = cost[x] < tb[x];
-      tb[x] = better ? cost[x] : tb[x];
-      tu[x] = better ? -iu : tu[x];
-      tv[x] = better ? -iv : tv[x];
-    }
-  }
-
-  std::size_t slot(int y) const {
-    return static_cast<std::size_t>(y % (2 * r_ + 1)) * static_cast<std::size_t>(a_.cols);
-  }
-
-  // Row y of d = b(x + (du, dv)) - a(x) and d^2 into the ring and the column sums.
-  void enter(const cv::Mat& b_padded, int pad, int du, int dv, int y) {
-    const int w = a_.cols;
-    const float* __restrict pa = a_.ptr<float>(y);
-    const float* __restrict pb = b_padded.ptr<float>(y + pad + dv) + pad + du;
-    float* __restrict d1 = ring1_.data() + slot(y);
-    float* __restrict d2 = ring2_.data() + slot(y);
-    float* __restrict c1 = c1_.data() + r_;
-    float* __restrict c2 = c2_.data() + r_;
-    for (int x = 0; x < w; ++x) {
-      const float d = pb[x] - pa[x];
-      d1[x] = d;
-      d2[x] = d * d;
-      c1[x] += d;
-      c2[x] += d * d;
-    }
-  }
-
-  void leave(int y) {
-    const int w = a_.cols;
-    const float* __restrict d1 = ring1_.data() + slot(y);
-    const float* __restrict d2 = ring2_.data() + slot(y);
-    float* __restrict c1 = c1_.data() + r_;
-    float* __restrict c2 = c2_.data() + r_;
-    for (int x = 0; x < w; ++x) {
-      c1[x] -= d1[x];
-      c2[x] -= d2[x];
-    }
-  }
-
-  const cv::Mat& a_;
-  int r_;
-  std::vector<float> c1_, c2_, s1_, s2_, ring1_, ring2_, inv_nx_, inv_ny_;
-};
-
+// Every pixel of `a` matched in `b` at each displacement of `order` (around `prior`): the
+// window costs of one displacement stream through a StreamingZssd row by row, and each row
+// updates the running best forward and, at the targets, backward.
 Matches match(const cv::Mat& a, const cv::Mat& b_padded, int pad, cv::Point prior,
               const std::vector<Displacement>& order, int window) {
-  const std::size_t n = static_cast<std::size_t>(a.cols) * a.rows;
+  const int w = a.cols, h = a.rows;
+  const std::size_t n = static_cast<std::size_t>(w) * h;
   Matches m;
   m.du.assign(n, prior.x);
   m.dv.assign(n, prior.y);
@@ -192,11 +67,45 @@ Matches match(const cv::Mat& a, const cv::Mat& b_padded, int pad, cv::Point prio
   m.back_du.assign(n, -prior.x);
   m.back_dv.assign(n, -prior.y);
   m.back_cost.assign(n, std::numeric_limits<float>::infinity());
-  DisplacementPass pass(a, window);
+  detail::StreamingZssd z(w, h, window);
+  std::vector<float> cost_row;
   for (const Displacement& s : order) {
+    const int du = prior.x + s.dx, dv = prior.y + s.dy;
     const bool at_prior = s.dx == 0 && s.dy == 0;
-    pass.run(b_padded, pad, prior.x + s.dx, prior.y + s.dy, m,
-             at_prior ? m.prior_cost.data() : nullptr);
+    const auto fill = [&](int y, float* __restrict d) {
+      const float* __restrict pa = a.ptr<float>(y);
+      const float* __restrict pb = b_padded.ptr<float>(y + pad + dv) + pad + du;
+      for (int x = 0; x < w; ++x)
+        d[x] = pb[x] - pa[x];
+    };
+    const auto use = [&](int y, const float* __restrict c) {
+      const std::size_t row = static_cast<std::size_t>(y) * w;
+      if (at_prior) std::copy_n(c, w, m.prior_cost.data() + row);
+      float* __restrict best = m.cost.data() + row;
+      std::int32_t* __restrict bu = m.du.data() + row;
+      std::int32_t* __restrict bv = m.dv.data() + row;
+      for (int x = 0; x < w; ++x) {
+        const bool better = c[x] < best[x];
+        best[x] = better ? c[x] : best[x];
+        bu[x] = better ? du : bu[x];
+        bv[x] = better ? dv : bv[x];
+      }
+      // The same costs are the backward search's at the targets t = x + (du, dv).
+      const int ty = y + dv;
+      if (ty < 0 || ty >= h) return;
+      const int x0 = std::max(0, -du), x1 = std::min(w, w - du);
+      const std::ptrdiff_t target = static_cast<std::ptrdiff_t>(ty) * w + du;  // + x
+      float* __restrict tb = m.back_cost.data() + target;
+      std::int32_t* __restrict tu = m.back_du.data() + target;
+      std::int32_t* __restrict tv = m.back_dv.data() + target;
+      for (int x = x0; x < x1; ++x) {
+        const bool better = c[x] < tb[x];
+        tb[x] = better ? c[x] : tb[x];
+        tu[x] = better ? -du : tu[x];
+        tv[x] = better ? -dv : tv[x];
+      }
+    };
+    detail::for_each_cost_row(z, fill, use, cost_row);
   }
   return m;
 }
@@ -302,10 +211,9 @@ void search_flow(const cv::Mat& i0, const cv::Mat& i1, cv::Point2f prior,
       near_v.at<float>(y, x) = near ? fwd.dv[k] : static_cast<float>(p.y);
     }
   }
-  detail::FieldCost field_cost(w, h, params.window);
   std::vector<float> prior_cost, near_cost;
-  field_cost(i0, i1, prior_u, prior_v, prior_cost);
-  field_cost(i0, i1, near_u, near_v, near_cost);
+  detail::field_costs(i0, i1, prior_u, prior_v, params.window, prior_cost);
+  detail::field_costs(i0, i1, near_u, near_v, params.window, near_cost);
   for (int y = 0; y < h; ++y) {
     float* pu = u.ptr<float>(y);
     float* pv = v.ptr<float>(y);

@@ -3,50 +3,82 @@
 #include <algorithm>
 #include <cstddef>
 
-#include <opencv2/imgproc.hpp>
-
 namespace roiflow::flow::detail {
 
-BoxSum::BoxSum(int w, int h, int r) : w_(w), h_(h), r_(r) {}
-
-void BoxSum::operator()(const float* src, float* dst) {
-  // OpenCV's box filter (running sums, vectorised); zeros outside make the clipped window.
-  const cv::Mat in(h_, w_, CV_32F, const_cast<float*>(src));
-  cv::Mat out(h_, w_, CV_32F, dst);
-  cv::boxFilter(in, out, CV_32F, cv::Size(2 * r_ + 1, 2 * r_ + 1), cv::Point(-1, -1), false,
-                cv::BORDER_CONSTANT);
-}
-
-ZssdWindow::ZssdWindow(int w, int h, int window)
+StreamingZssd::StreamingZssd(int w, int h, int window)
     : w_(w),
       h_(h),
-      box_(w, h, window / 2),
-      inv_count_(static_cast<std::size_t>(w) * h),
-      squares_(inv_count_.size()),
-      s1_(inv_count_.size()),
-      s2_(inv_count_.size()) {
-  const int r = window / 2;
-  for (int y = 0; y < h; ++y) {
-    const int ny = std::min(h - 1, y + r) - std::max(0, y - r) + 1;
-    for (int x = 0; x < w; ++x) {
-      const int nx = std::min(w - 1, x + r) - std::max(0, x - r) + 1;
-      inv_count_[static_cast<std::size_t>(y) * w + x] = 1.f / static_cast<float>(nx * ny);
-    }
+      r_(window / 2),
+      ring_(static_cast<std::size_t>(2 * r_ + 1) * w),
+      squares_(ring_.size()),
+      c1_(w + 2 * r_, 0.f),
+      c2_(w + 2 * r_, 0.f),
+      inv_nx_(w),
+      inv_ny_(h) {
+  for (int x = 0; x < w; ++x)
+    inv_nx_[x] = 1.f / static_cast<float>(std::min(w - 1, x + r_) - std::max(0, x - r_) + 1);
+  for (int y = 0; y < h; ++y)
+    inv_ny_[y] = 1.f / static_cast<float>(std::min(h - 1, y + r_) - std::max(0, y - r_) + 1);
+}
+
+void StreamingZssd::reset() {
+  std::fill(c1_.begin(), c1_.end(), 0.f);
+  std::fill(c2_.begin(), c2_.end(), 0.f);
+}
+
+float* StreamingZssd::row(int y) {
+  return ring_.data() + static_cast<std::size_t>(y % (2 * r_ + 1)) * w_;
+}
+
+void StreamingZssd::add(int y) {
+  const float* __restrict d = row(y);
+  float* __restrict sq = squares_.data() + (d - ring_.data());
+  float* __restrict c1 = c1_.data() + r_;
+  float* __restrict c2 = c2_.data() + r_;
+  for (int x = 0; x < w_; ++x) {
+    sq[x] = d[x] * d[x];
+    c1[x] += d[x];
+    c2[x] += sq[x];
   }
 }
 
-void ZssdWindow::operator()(const float* d, float* cost) {
-  const std::size_t n = inv_count_.size();
-  float* __restrict sq = squares_.data();
-  for (std::size_t i = 0; i < n; ++i)
-    sq[i] = d[i] * d[i];
-  box_(d, s1_.data());
-  box_(sq, s2_.data());
-  const float* __restrict s1 = s1_.data();
-  const float* __restrict s2 = s2_.data();
-  const float* __restrict inv = inv_count_.data();
-  for (std::size_t i = 0; i < n; ++i)
-    cost[i] = s2[i] - s1[i] * s1[i] * inv[i];
+void StreamingZssd::remove(int y) {
+  const float* __restrict d = row(y);
+  const float* __restrict sq = squares_.data() + (d - ring_.data());
+  float* __restrict c1 = c1_.data() + r_;
+  float* __restrict c2 = c2_.data() + r_;
+  for (int x = 0; x < w_; ++x) {
+    c1[x] -= d[x];
+    c2[x] -= sq[x];
+  }
+}
+
+void StreamingZssd::costs(int y, float* out) {
+  // The search and the fusion use 7x7 windows: with the radius known at compile time the taps
+  // unroll and the loop vectorises along x.
+  if (r_ == 3) {
+    costs_impl<3>(y, out);
+  } else {
+    costs_impl<-1>(y, out);
+  }
+}
+
+template <int kR>
+void StreamingZssd::costs_impl(int y, float* __restrict out) {
+  const int r = kR >= 0 ? kR : r_;
+  const float* __restrict c1 = c1_.data();
+  const float* __restrict c2 = c2_.data();
+  const float* __restrict inx = inv_nx_.data();
+  const float iny = inv_ny_[y];
+  for (int x = 0; x < w_; ++x) {
+    float s1 = 0.f, s2 = 0.f;
+#pragma GCC unroll 16
+    for (int k = 0; k <= 2 * r; ++k) {
+      s1 += c1[x + k];
+      s2 += c2[x + k];
+    }
+    out[x] = s2 - s1 * s1 * (inx[x] * iny);
+  }
 }
 
 void warp_difference_row(const cv::Mat& i1, const float* __restrict i0, int y, int w,
@@ -72,18 +104,21 @@ void warp_difference_row(const cv::Mat& i1, const float* __restrict i0, int y, i
   }
 }
 
-FieldCost::FieldCost(int w, int h, int window)
-    : zssd_(w, h, window), d_(static_cast<std::size_t>(w) * h) {}
-
-void FieldCost::operator()(const cv::Mat& i0, const cv::Mat& i1, const cv::Mat& u, const cv::Mat& v,
-                           std::vector<float>& cost) {
+void field_costs(const cv::Mat& i0, const cv::Mat& i1, const cv::Mat& u, const cv::Mat& v,
+                 int window, std::vector<float>& cost) {
   const int w = i0.cols;
-  for (int y = 0; y < i0.rows; ++y) {
-    warp_difference_row(i1, i0.ptr<float>(y), y, w, u.ptr<float>(y), v.ptr<float>(y),
-                        d_.data() + static_cast<std::size_t>(y) * w);
-  }
-  cost.resize(d_.size());
-  zssd_(d_.data(), cost.data());
+  StreamingZssd z(w, i0.rows, window);
+  std::vector<float> cost_row;
+  cost.resize(static_cast<std::size_t>(w) * i0.rows);
+  for_each_cost_row(
+      z,
+      [&](int y, float* d) {
+        warp_difference_row(i1, i0.ptr<float>(y), y, w, u.ptr<float>(y), v.ptr<float>(y), d);
+      },
+      [&](int y, const float* c) {
+        std::copy_n(c, w, cost.data() + static_cast<std::size_t>(y) * w);
+      },
+      cost_row);
 }
 
 }  // namespace roiflow::flow::detail
