@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 
+#include "flow/large_motion.hpp"
 #include "flow/pyramid.hpp"
 #include "pipeline/tbb_executor.hpp"
 
@@ -24,8 +25,48 @@ void add_lk_options(CLI::App& cmd, LkOptions& lk) {
   cmd.add_option("--patch", lk.patch, "window side in pixels")
       ->check(CLI::Range(3, 31))
       ->group(group);
-  cmd.add_option("--levels", lk.levels, "pyramid levels")
-      ->check(CLI::Range(1, flow::kMaxLevels))
+  cmd.add_option("--levels", lk.levels,
+                 "pyramid levels, or auto (from the frame size and --expected-motion)")
+      ->type_name("N|auto")
+      ->check(CLI::Range(1, flow::kMaxLevels) | CLI::IsMember({"auto"}))
+      ->group(group);
+  cmd.add_option("--expected-motion", lk.expected_motion,
+                 "largest motion to expect, pixels (0 = a quarter of the larger side): sets "
+                 "--levels auto and the coarse search's radius")
+      ->check(CLI::Range(0.0, 1e5))
+      ->group(group);
+  cmd.add_option("--search-radius", lk.search_radius,
+                 "coarse search at the coarsest level: largest radius in its pixels (0 = off)")
+      ->check(CLI::Range(0, flow::kMaxSearchRadius))
+      ->group(group);
+  cmd.add_option("--coarsest-side", lk.coarsest_side,
+                 "--levels auto: the coarsest level's shorter side, pixels")
+      ->check(CLI::Range(flow::kMinLevelSide, 480))
+      ->group(group);
+  cmd.add_option("--fuse-far-step", lk.fuse_far_step,
+                 "candidate fusion before each level, first pass: neighbours this many pixels "
+                 "away (0 = off)")
+      ->check(CLI::Range(0, 32))
+      ->group(group);
+  cmd.add_option("--fuse-far-finest-level", lk.fuse_far_finest_level,
+                 "finest pyramid level the first fusion pass runs on")
+      ->check(CLI::Range(0, flow::kMaxLevels - 1))
+      ->group(group);
+  cmd.add_option("--fuse-step", lk.fuse_step,
+                 "candidate fusion, second pass: neighbours this many pixels away (0 = off)")
+      ->check(CLI::Range(0, 32))
+      ->group(group);
+  cmd.add_option("--fuse-finest-level", lk.fuse_finest_level,
+                 "finest pyramid level the second fusion pass runs on")
+      ->check(CLI::Range(0, flow::kMaxLevels - 1))
+      ->group(group);
+  cmd.add_option("--mask-outside", lk.mask_outside,
+                 "samples of frame t+1 outside the frame carry no brightness term (0 or 1)")
+      ->check(CLI::IsMember({0, 1}))
+      ->group(group);
+  cmd.add_option("--finest-level", lk.finest_level,
+                 "pyramid level LK stops at; finer levels get the upsampled flow")
+      ->check(CLI::Range(0, flow::kMaxLevels - 1))
       ->group(group);
   cmd.add_option("--iterations", lk.iterations, "refinement iterations per level")
       ->check(CLI::Range(1, 50))
@@ -56,7 +97,16 @@ void add_lk_options(CLI::App& cmd, LkOptions& lk) {
 flow::LkParams lk_params(const LkOptions& lk) {
   flow::LkParams params = flow::LkParams::preset(lk.preset);
   if (lk.patch) params.patch = *lk.patch;
-  if (lk.levels) params.levels = *lk.levels;
+  if (lk.levels) params.levels = *lk.levels == "auto" ? 0 : std::stoi(*lk.levels);
+  if (lk.expected_motion) params.expected_motion = *lk.expected_motion;
+  if (lk.search_radius) params.search_radius = *lk.search_radius;
+  if (lk.coarsest_side) params.coarsest_side = *lk.coarsest_side;
+  if (lk.fuse_far_step) params.fuse_far_step = *lk.fuse_far_step;
+  if (lk.fuse_far_finest_level) params.fuse_far_finest_level = *lk.fuse_far_finest_level;
+  if (lk.fuse_step) params.fuse_step = *lk.fuse_step;
+  if (lk.fuse_finest_level) params.fuse_finest_level = *lk.fuse_finest_level;
+  if (lk.mask_outside) params.mask_outside = *lk.mask_outside != 0;
+  if (lk.finest_level) params.finest_level = *lk.finest_level;
   if (lk.iterations) params.iterations = *lk.iterations;
   if (lk.sigma) params.sigma = *lk.sigma;
   if (lk.lambda) params.lambda = *lk.lambda;

@@ -23,7 +23,11 @@ class UsageError : public Error {
 // Overrides stay empty unless given, so they apply on top of whichever preset was chosen.
 struct LkOptions {
   std::string preset = "paper";
-  std::optional<int> patch, levels, iterations, level_median, final_median;
+  std::optional<int> patch, iterations, level_median, final_median;
+  std::optional<std::string> levels;  // N or "auto"
+  std::optional<int> coarsest_side, search_radius, fuse_far_step, fuse_far_finest_level;
+  std::optional<int> fuse_step, fuse_finest_level, mask_outside, finest_level;
+  std::optional<double> expected_motion;
   std::optional<double> sigma, lambda, robust_scale;
   std::optional<std::string> derivative;
   int threads = 1;

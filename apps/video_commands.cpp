@@ -385,7 +385,22 @@ std::vector<std::string> child_args(const TrackCommand& cmd, const std::string& 
                                 std::to_string(cmd.lk.threads)};
   if (!cmd.init.empty()) a.insert(a.end(), {"--init", cmd.init});
   const LkOptions& lk = cmd.lk;
-  if (lk.levels) a.insert(a.end(), {"--levels", std::to_string(*lk.levels)});
+  if (lk.levels) a.insert(a.end(), {"--levels", *lk.levels});
+  if (lk.expected_motion) a.insert(a.end(), {"--expected-motion", exact(*lk.expected_motion)});
+  if (lk.search_radius) a.insert(a.end(), {"--search-radius", std::to_string(*lk.search_radius)});
+  if (lk.coarsest_side) {
+    a.insert(a.end(), {"--coarsest-side", std::to_string(*lk.coarsest_side)});
+  }
+  if (lk.fuse_far_step) a.insert(a.end(), {"--fuse-far-step", std::to_string(*lk.fuse_far_step)});
+  if (lk.fuse_far_finest_level) {
+    a.insert(a.end(), {"--fuse-far-finest-level", std::to_string(*lk.fuse_far_finest_level)});
+  }
+  if (lk.fuse_step) a.insert(a.end(), {"--fuse-step", std::to_string(*lk.fuse_step)});
+  if (lk.fuse_finest_level) {
+    a.insert(a.end(), {"--fuse-finest-level", std::to_string(*lk.fuse_finest_level)});
+  }
+  if (lk.mask_outside) a.insert(a.end(), {"--mask-outside", std::to_string(*lk.mask_outside)});
+  if (lk.finest_level) a.insert(a.end(), {"--finest-level", std::to_string(*lk.finest_level)});
   if (lk.iterations) a.insert(a.end(), {"--iterations", std::to_string(*lk.iterations)});
   if (lk.level_median) a.insert(a.end(), {"--level-median", std::to_string(*lk.level_median)});
   if (lk.final_median) a.insert(a.end(), {"--final-median", std::to_string(*lk.final_median)});

@@ -3,14 +3,18 @@
 //
 //   build/release/bench/flow_bench --benchmark_filter=640x480
 //
-//   BM_Flow/<method>/<W>x<H>/threads:<n>   method: roiflow_paper, roiflow_accurate,
+//   BM_Flow/<method>/<W>x<H>/threads:<n>   method: roiflow_paper, roiflow_accurate, roiflow_fast,
 //                                          dis_ultrafast, dis_fast, dis_medium, farneback
 //   BM_Pyramid/<W>x<H>                     build_pyramid(frame) alone (paper preset), 1 thread
 //   BM_Pretreatment/<roiflow|opencv>/<W>x<H>  level 0 alone (sigma 0.5): roiflow's fused pass vs
 //                                          OpenCV's convertTo + GaussianBlur, 1 thread
-//   BM_Middlebury/<method>/threads:1       with ROIFLOW_MIDDLEBURY=DIR set: every sequence of
-//                                          that Middlebury tree per iteration; counters EPE and
-//                                          AAE are the means over sequences, ms_per_pair the time
+//   BM_Dataset/<dataset>/<method>/threads:1  with ROIFLOW_DATA=ROOT (e.g. ../shared/data): one
+//                                          per evaluation tree under ROOT (middlebury, kitti,
+//                                          sintel, flyingchairs; partial trees as `roiflow eval`
+//                                          reads them), every pair per iteration; counters EPE,
+//                                          AAE and Fl are the means over pairs (Sintel's invalid
+//                                          pixels not scored), ms_per_pair the time, pairs the
+//                                          count. ROIFLOW_MIDDLEBURY=DIR adds DIR as "middlebury".
 //
 // Every benchmark runs inside run_with_threads(n): n arena slots for roiflow's stripes and
 // cv::setNumThreads(n) for OpenCV's own loops (DIS, Farneback, and the remap/pyrDown roiflow
@@ -20,9 +24,12 @@
 // timing loop. Frames: make_scene(MovingObject), built once per size on first use.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <functional>
 #include <map>
 #include <memory>
@@ -31,7 +38,7 @@
 #include <utility>
 #include <vector>
 
-#include "eval/flo_io.hpp"
+#include "core/error.hpp"
 #include "eval/flow_eval.hpp"
 #include "eval/synthetic.hpp"
 #include "flow/dense_lk.hpp"
@@ -87,7 +94,14 @@ FlowFn roiflow_flow(const roiflow::flow::LkParams& params) {
 
 FlowFn dis_flow(int preset) {
   cv::Ptr<cv::DISOpticalFlow> dis = cv::DISOpticalFlow::create(preset);
-  return [dis](const Scene& s, cv::Mat& flow) { dis->calc(s.frame0, s.frame1, flow); };
+  return [dis](const Scene& s, cv::Mat& flow) {
+    // DIS takes a flow argument of the frames' size as its initial flow: handing it back the
+    // flow of the previous call on the same pair (as a timing loop does) would start it from a
+    // converged answer. A fresh output makes every call compute from scratch, as roiflow's do.
+    cv::Mat out;
+    dis->calc(s.frame0, s.frame1, out);
+    flow = out;
+  };
 }
 
 FlowFn farneback_flow() {
@@ -101,6 +115,7 @@ const std::vector<Method>& methods() {
   static const std::vector<Method> all = {
       {"roiflow_paper", [] { return roiflow_flow(roiflow::flow::LkParams::paper()); }},
       {"roiflow_accurate", [] { return roiflow_flow(roiflow::flow::LkParams::accurate()); }},
+      {"roiflow_fast", [] { return roiflow_flow(roiflow::flow::LkParams::fast()); }},
       {"dis_ultrafast", [] { return dis_flow(cv::DISOpticalFlow::PRESET_ULTRAFAST); }},
       {"dis_fast", [] { return dis_flow(cv::DISOpticalFlow::PRESET_FAST); }},
       {"dis_medium", [] { return dis_flow(cv::DISOpticalFlow::PRESET_MEDIUM); }},
@@ -162,47 +177,91 @@ void bm_pretreatment(benchmark::State& state, cv::Size size, bool opencv) {
   });
 }
 
-// Real data with ground truth: the Middlebury pairs as scenes (frames, ground-truth flow).
-std::vector<Scene> middlebury_scenes(const std::string& dir) {
+// Real data with ground truth: a dataset's pairs as scenes (frames, ground-truth flow), with the
+// pixels its tree says not to score (Sintel's invalid masks), as `roiflow eval` reads them.
+struct Dataset {
+  std::string name;
   std::vector<Scene> scenes;
-  for (const roiflow::eval::EvalPair& pair : roiflow::eval::find_middlebury(dir)) {
-    scenes.push_back({roiflow::eval::read_gray(pair.frame0), roiflow::eval::read_gray(pair.frame1),
-                      roiflow::eval::read_flo(pair.ground_truth)});
+  std::vector<cv::Mat> excluded;  // empty Mat = score every pixel with a ground truth
+};
+
+Dataset load_dataset(const std::string& name, const std::string& dir) {
+  Dataset data{name, {}, {}};
+  std::vector<std::string> skipped;
+  for (const roiflow::eval::EvalPair& pair : roiflow::eval::find_pairs(dir, {}, &skipped)) {
+    data.scenes.push_back({roiflow::eval::read_gray(pair.frame0),
+                           roiflow::eval::read_gray(pair.frame1),
+                           roiflow::eval::read_flow_ground_truth(pair.ground_truth)});
+    data.excluded.push_back(
+        pair.exclude_mask.empty() ? cv::Mat() : roiflow::eval::read_gray(pair.exclude_mask));
   }
-  return scenes;
+  if (!skipped.empty()) {
+    std::fprintf(stderr, "flow_bench: %s: %s\n", name.c_str(),
+                 roiflow::eval::skipped_line(skipped).c_str());
+  }
+  return data;
 }
 
-void bm_middlebury(benchmark::State& state, const Method& method,
-                   const std::vector<Scene>* scenes) {
+// Every evaluation tree directly under `root` (middlebury, kitti, sintel, flyingchairs, ...),
+// sorted by name; folders that hold none (tracking videos, ...) are left out.
+std::vector<Dataset> load_datasets(const std::string& root) {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(root, ec)) {
+    if (!entry.is_directory()) continue;
+    try {
+      roiflow::eval::detect_layout(entry.path().string());
+      names.push_back(entry.path().filename().string());
+    } catch (const roiflow::Error&) {  // not an evaluation tree
+    }
+  }
+  if (ec) throw roiflow::Error("cannot list '" + root + "': " + ec.message());
+  std::sort(names.begin(), names.end());
+  std::vector<Dataset> out;
+  for (const std::string& name : names)
+    out.push_back(load_dataset(name, (std::filesystem::path(root) / name).string()));
+  return out;
+}
+
+void bm_dataset(benchmark::State& state, const Method& method, const Dataset* data) {
   roiflow::pipeline::run_with_threads(1, [&] {
     const FlowFn flow_fn = method.make();
-    std::vector<cv::Mat> flows(scenes->size());
+    const std::size_t n = data->scenes.size();
+    std::vector<cv::Mat> flows(n);
     for (auto _ : state) {
-      for (size_t i = 0; i < scenes->size(); ++i)
-        flow_fn((*scenes)[i], flows[i]);
+      for (std::size_t i = 0; i < n; ++i)
+        flow_fn(data->scenes[i], flows[i]);
       benchmark::ClobberMemory();
     }
-    double epe = 0, aae = 0;
-    for (size_t i = 0; i < scenes->size(); ++i) {
-      const roiflow::flow::FlowErrors e = roiflow::flow::flow_errors(flows[i], (*scenes)[i].flow);
-      epe += e.epe / static_cast<double>(scenes->size());
-      aae += e.aae_deg / static_cast<double>(scenes->size());
+    double epe = 0, aae = 0, fl = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const roiflow::flow::FlowErrors e =
+          roiflow::flow::flow_errors(flows[i], data->scenes[i].flow, data->excluded[i]);
+      epe += e.epe / static_cast<double>(n);
+      aae += e.aae_deg / static_cast<double>(n);
+      fl += e.fl / static_cast<double>(n);
     }
     state.counters["EPE"] = epe;
     state.counters["AAE"] = aae;
+    state.counters["Fl"] = fl;
+    state.counters["pairs"] = static_cast<double>(n);
     state.counters["ms_per_pair"] =
-        benchmark::Counter(static_cast<double>(state.iterations() * scenes->size()) / 1e3,
+        benchmark::Counter(static_cast<double>(state.iterations() * n) / 1e3,
                            benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
   });
 }
 
 void register_benchmarks() {
+  static std::vector<Dataset> datasets;
+  if (const char* root = std::getenv("ROIFLOW_DATA")) datasets = load_datasets(root);
   if (const char* dir = std::getenv("ROIFLOW_MIDDLEBURY")) {
-    static const std::vector<Scene> scenes = middlebury_scenes(dir);
+    datasets.push_back(load_dataset("middlebury", dir));
+  }
+  for (const Dataset& data : datasets) {
     for (const Method& method : methods()) {
       benchmark::RegisterBenchmark(
-          ("BM_Middlebury/" + std::string(method.name) + "/threads:1").c_str(), bm_middlebury,
-          method, &scenes)
+          ("BM_Dataset/" + data.name + "/" + method.name + "/threads:1").c_str(), bm_dataset,
+          method, &data)
           ->Unit(benchmark::kMillisecond)
           ->UseRealTime()
           ->Iterations(3);

@@ -12,9 +12,20 @@ cd "$(dirname "$0")/.."
 source scripts/gate_lib.sh
 root=$1
 bin=${2:-build/release}/roiflow
-#        folder      preset    pairs  max mean EPE  max mean AAE (measured: EPE / AAE)
-gates=("middlebury   paper     8      0.88          7.40"   # 0.843 / 7.11
-       "middlebury   accurate  8      0.465         5.60")  # 0.443 / 5.35
+# KITTI, Sintel and FlyingChairs are ../shared/data's partial downloads (2, 4 and 6 pairs; KITTI
+# 000000 has no flow_noc, each Sintel scene one pass): `roiflow eval` scores what is there.
+# Their means hang on one or two pairs with 50-190 px motions (KITTI 000000, Sintel temple_3),
+# so their gates keep the same ~4-5 % (fast Chairs 1.8 %: the issue-18 bar, DIS ULTRAFAST's 4.19).
+#        folder        preset    pairs  max mean EPE  max mean AAE (measured: EPE / AAE)
+gates=("middlebury     paper     8      0.88          7.40"   # 0.843 / 7.11
+       "middlebury     accurate  8      0.40          5.06"   # 0.385 / 4.87
+       "middlebury     fast      8      0.92          12.1"   # 0.886 / 11.64
+       "kitti          accurate  2      13.7          20.8"   # 13.08 / 19.91
+       "kitti          fast      2      17.4          23.2"   # 16.69 / 22.33
+       "sintel         accurate  4      12.2          15.8"   # 11.59 / 15.20
+       "sintel         fast      4      13.9          21.0"   # 13.33 / 20.21
+       "flyingchairs   accurate  6      3.81          12.4"   # 3.666 / 11.94
+       "flyingchairs   fast      6      4.19          16.2")  # 4.115 / 15.53
 status=0
 for gate in "${gates[@]}"; do
   read -r folder preset pairs max_epe max_aae <<<"$gate"

@@ -1,7 +1,7 @@
 // Executor — how the flow core runs independent row stripes.
 //
 //   roiflow::SerialExecutor serial;            // the default: one thread
-//   roiflow::flow::DenseLK lk(roiflow::flow::LkParams::paper(), &serial);
+//   dense_flow(a, b, params, {}, &serial);
 //
 // src/flow knows no threads. A caller that wants parallel stripes (the pipeline does it with
 // tbb::parallel_for) passes an Executor whose for_range may run body(begin, end) on disjoint

@@ -7,28 +7,31 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "flow/large_motion.hpp"
 #include "flow/lk_level.hpp"
 
 namespace roiflow::flow {
 
 using detail::iterate_level;
+using detail::LevelInput;
 using detail::LevelProblem;
 using detail::make_window;
 using detail::upsample_flow;
-using detail::Window;
-using detail::window_weight;
 
 // Everything a DenseLK keeps between calls.
 struct DenseLK::Workspace {
   Pyramid pyr_t, pyr_t1;
-  std::vector<cv::Mat> u, v, u_next, v_next;  // per level
-  cv::Mat confidence;                         // level 0, when only a region is returned
+  std::vector<cv::Mat> u, v;  // per level
+  cv::Mat init_u, init_v;     // options.initial_flow, split
+  cv::Mat seed_u, seed_v;     // a level's starting flow, when large_motion.hpp seeds it
+  cv::Mat confidence;         // the finest level's
   detail::LevelScratch scratch;
 
   std::size_t bytes() const {
-    std::size_t n = scratch.bytes() + confidence.total() * confidence.elemSize();
-    for (const std::vector<cv::Mat>* mats :
-         {&pyr_t.levels, &pyr_t1.levels, &u, &v, &u_next, &v_next}) {
+    std::size_t n = scratch.bytes();
+    for (const cv::Mat* m : {&init_u, &init_v, &seed_u, &seed_v, &confidence})
+      n += m->total() * m->elemSize();
+    for (const std::vector<cv::Mat>* mats : {&pyr_t.levels, &pyr_t1.levels, &u, &v}) {
       for (const cv::Mat& m : *mats)
         n += m.total() * m.elemSize();
     }
@@ -69,8 +72,9 @@ LevelPlan plan_levels(cv::Size size, const LkParams& params, const FlowOptions& 
   }
   LevelPlan plan;
   plan.top = flow_pyramid_levels(size, params, options);
-  plan.finest = std::min(options.finest_level, plan.top - 1);
-  const Window win = make_window(params.patch, params.derivative == Derivative::HornSchunck);
+  plan.finest = std::min(std::max(options.finest_level, params.finest_level), plan.top - 1);
+  const detail::Window win =
+      make_window(params.patch, params.derivative == Derivative::HornSchunck);
   // Flow at a pixel after one iteration depends on the previous flow within the window plus
   // the derivative stencil: computing on a margin of this many pixels per iteration makes a
   // region's flow equal the whole frame's flow inside the region (up to rounding).
@@ -110,16 +114,13 @@ void confidence_to_level0(const cv::Mat& src, const cv::Rect& from, int level,
 }
 
 // The flow the coarsest level `level` (of size `level_size`) starts from over its computed
-// rectangle `c`: options.initial_flow there, or options.initial_motion in that level's pixels.
-void coarsest_flow(const FlowOptions& options, int level, cv::Size level_size, const cv::Rect& c,
-                   cv::Mat& u, cv::Mat& v) {
-  u.create(c.size(), CV_32F);
-  v.create(c.size(), CV_32F);
+// rectangle `c`: options.initial_flow there (split into u, v), or options.initial_motion in that
+// level's pixels.
+LevelInput coarsest_input(const FlowOptions& options, int level, cv::Size level_size,
+                          const cv::Rect& c, cv::Mat& u, cv::Mat& v) {
   if (options.initial_flow.empty()) {
     const float scale = 1.f / static_cast<float>(1 << level);
-    u.setTo(options.initial_motion.x * scale);
-    v.setTo(options.initial_motion.y * scale);
-    return;
+    return LevelInput::constant(options.initial_motion.x * scale, options.initial_motion.y * scale);
   }
   const cv::Mat& init = options.initial_flow;
   if (init.type() != CV_32FC2 || init.size() != level_size) {
@@ -128,33 +129,53 @@ void coarsest_flow(const FlowOptions& options, int level, cv::Size level_size, c
                 " (level " + std::to_string(level) + "), got " + cv::typeToString(init.type()) +
                 " " + std::to_string(init.cols) + "x" + std::to_string(init.rows));
   }
+  u.create(c.size(), CV_32F);
+  v.create(c.size(), CV_32F);
   cv::Mat planes[] = {u, v};
   cv::split(init(c), planes);
+  return LevelInput::planes(u, v);
 }
 
-// The problem of one level: its images, the computed rectangle `c` and the window weights.
+// `input` (over the computed rectangle `c`) as planes u, v of c's size.
+void starting_planes(const LevelInput& input, const cv::Rect& c, cv::Mat& u, cv::Mat& v) {
+  switch (input.kind) {
+    case LevelInput::Kind::Constant:
+      u.create(c.size(), CV_32F);
+      v.create(c.size(), CV_32F);
+      u.setTo(input.u);
+      v.setTo(input.v);
+      return;
+    case LevelInput::Kind::Planes:
+      input.pu->copyTo(u);
+      input.pv->copyTo(v);
+      return;
+    case LevelInput::Kind::Coarser:
+      upsample_flow(*input.pu, input.coarse_origin, c, u);
+      upsample_flow(*input.pv, input.coarse_origin, c, v);
+      return;
+  }
+}
+
+// The problem of one level: its images, the computed rectangle `c` and the window.
 LevelProblem level_problem(const cv::Mat& i0, const cv::Mat& i1, const cv::Rect& c,
                            const LkParams& params) {
-  const Window win = make_window(params.patch, params.derivative == Derivative::HornSchunck);
   LevelProblem p;
   p.i0 = &i0;
   p.i1 = &i1;
   p.comp = c;
   p.derivative = params.derivative;
-  p.win = win;
+  p.win = make_window(params.patch, params.derivative == Derivative::HornSchunck);
   p.lambda = static_cast<float>(params.lambda);
   p.robust_inv_scale2 = params.robust_scale > 0
                             ? static_cast<float>(1.0 / (params.robust_scale * params.robust_scale))
                             : 0.f;
-  // Windows are clipped at the computed rectangle; near the image border that is the
-  // image border, elsewhere only pixels outside the wanted region are affected.
-  p.inv_cx.resize(c.width);
-  for (int x = 0; x < c.width; ++x)
-    p.inv_cx[x] = 1.f / window_weight(win, x, c.width);
-  p.cy.resize(c.height);
-  for (int y = 0; y < c.height; ++y)
-    p.cy[y] = window_weight(win, y, c.height);
+  p.mask_outside = params.mask_outside;
   return p;
+}
+
+// The first `size` pixels of a level plane (LK planes are padded, see iterate_level).
+cv::Mat view(const cv::Mat& plane, cv::Size size) {
+  return plane(cv::Rect(cv::Point(), size));
 }
 
 // Dense flow from pyramids with `ws`'s buffers (params already validated).
@@ -172,45 +193,70 @@ void flow_from_pyramids(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkPar
     throw Error("pyramid has " + std::to_string(std::min(pyr_t.num_levels(), pyr_t1.num_levels())) +
                 " levels, " + std::to_string(levels) + " needed");
   }
-
   const std::vector<cv::Rect>& comp = plan.comp;
-
   const SerialExecutor serial;
   const Executor& exec = executor ? *executor : serial;
 
-  for (auto* mats : {&ws.u, &ws.v, &ws.u_next, &ws.v_next})
-    mats->resize(levels);
-  // The finest level computes the confidence straight into the result when it is level 0 and
-  // the region is all of it.
-  const cv::Rect crop(region.tl() - comp[0].tl(), region.size());
-  const bool direct = plan.finest == 0 && crop.size() == comp[0].size();
-  cv::Mat& confidence = direct ? result.confidence : ws.confidence;
+  ws.u.resize(levels);
+  ws.v.resize(levels);
+  // The last iteration writes the result itself when it is level 0's whole computed rectangle
+  // and no median follows.
+  const bool direct =
+      plan.finest == 0 && params.final_median == 0 && region.size() == comp[0].size();
   for (int l = levels - 1; l >= 0; --l) {
     const cv::Rect& c = comp[l];
-    cv::Mat& u = ws.u[l];
-    cv::Mat& v = ws.v[l];
-    if (l == levels - 1) {
-      coarsest_flow(options, l, level_size(size, l), c, u, v);
-    } else {
-      upsample_flow(ws.u[l + 1], comp[l + 1].tl(), c, u);
-      upsample_flow(ws.v[l + 1], comp[l + 1].tl(), c, v);
+    if (l < plan.finest) {  // below the finest level the flow is only upsampled
+      upsample_flow(view(ws.u[l + 1], comp[l + 1].size()), comp[l + 1].tl(), c, ws.u[l]);
+      upsample_flow(view(ws.v[l + 1], comp[l + 1].size()), comp[l + 1].tl(), c, ws.v[l]);
+      continue;
     }
-    if (l < plan.finest) continue;  // below the finest level the flow is only upsampled
+    cv::Mat coarse_u, coarse_v;  // LevelInput points at these
+    if (l < levels - 1) {
+      coarse_u = view(ws.u[l + 1], comp[l + 1].size());
+      coarse_v = view(ws.v[l + 1], comp[l + 1].size());
+    }
+    LevelInput input =
+        l == levels - 1 ? coarsest_input(options, l, level_size(size, l), c, ws.init_u, ws.init_v)
+                        : LevelInput::coarser(coarse_u, coarse_v, comp[l + 1].tl());
+    if (detail::seeds_level(params, l, levels, options)) {
+      // The coarse search and the candidate fusion work on the level's starting flow as planes.
+      starting_planes(input, c, ws.seed_u, ws.seed_v);
+      detail::seed_level(params, pyr_t.levels[l], pyr_t1.levels[l], c, l, levels, options,
+                         ws.seed_u, ws.seed_v);
+      input = LevelInput::planes(ws.seed_u, ws.seed_v);
+    }
     const LevelProblem p = level_problem(pyr_t.levels[l], pyr_t1.levels[l], c, params);
     const bool finest = l == plan.finest;
-    if (finest) confidence.create(c.size(), CV_32F);
-    iterate_level(p, u, v, ws.u_next[l], ws.v_next[l], finest ? &confidence : nullptr,
-                  params.iterations, exec, ws.scratch);
+    if (finest && direct) {
+      iterate_level(p, input, ws.u[l], ws.v[l], &result.confidence, params.iterations, exec,
+                    ws.scratch, &result.flow);
+      result.region = region;
+      return;
+    }
+    iterate_level(p, input, ws.u[l], ws.v[l], finest ? &ws.confidence : nullptr, params.iterations,
+                  exec, ws.scratch);
+    cv::Mat u = view(ws.u[l], c.size()), v = view(ws.v[l], c.size());
     median_filter(u, v, finest ? params.final_median : params.level_median);
   }
 
-  const cv::Mat planes[] = {ws.u[0](crop), ws.v[0](crop)};
+  const cv::Rect crop(region.tl() - comp[0].tl(), region.size());
+  const cv::Mat u = view(ws.u[0], comp[0].size())(crop), v = view(ws.v[0], comp[0].size())(crop);
+  const cv::Mat confidence = view(ws.confidence, comp[plan.finest].size());
   result.flow.create(crop.size(), CV_32FC2);
-  cv::merge(planes, 2, result.flow);
   if (plan.finest > 0) {
+    const cv::Mat planes[] = {u, v};
+    cv::merge(planes, 2, result.flow);
     confidence_to_level0(confidence, comp[plan.finest], plan.finest, region, result.confidence);
-  } else if (!direct) {
-    confidence(crop).copyTo(result.confidence);
+  } else {
+    result.confidence.create(crop.size(), CV_32F);
+    // Row blocks on the executor: at VGA these copies are a few per cent of a pair.
+    exec.for_range(0, crop.height, 64, [&](int y0, int y1) {
+      const cv::Rect rows(0, y0, crop.width, y1 - y0);
+      const cv::Mat planes[] = {u(rows), v(rows)};
+      cv::Mat out = result.flow(rows);
+      cv::merge(planes, 2, out);
+      confidence(crop)(rows).copyTo(result.confidence(rows));
+    });
   }
   result.region = region;
 }
@@ -233,8 +279,10 @@ cv::Rect flow_footprint(cv::Size size, const LkParams& params, const FlowOptions
 }
 
 int flow_pyramid_levels(cv::Size size, const LkParams& params, const FlowOptions& options) {
-  const int finest = std::clamp(options.finest_level, 0, kMaxLevels - 1);
-  const int top = std::max(params.levels, finest + std::min(params.levels, 2));
+  const int finest =
+      std::clamp(std::max(options.finest_level, params.finest_level), 0, kMaxLevels - 1);
+  const int levels = detail::requested_levels(size, params);
+  const int top = std::max(levels, finest + std::min(levels, 2));
   return effective_levels(size, std::min(kMaxLevels, top));
 }
 
@@ -250,6 +298,13 @@ DenseLK& DenseLK::operator=(DenseLK&&) noexcept = default;
 void DenseLK::set_params(const LkParams& params) {
   params.validate();
   params_ = params;
+}
+
+void DenseLK::reserve(cv::Size size, const FlowOptions& options) {
+  // A pair of black frames takes every buffer a pair of this size takes.
+  const cv::Mat black = cv::Mat::zeros(size, CV_8UC1);
+  FlowResult ignored;
+  calc(black, black, ignored, options);
 }
 
 void DenseLK::collectGarbage() {
@@ -270,8 +325,18 @@ void DenseLK::calc(const cv::Mat& frame_t, const cv::Mat& frame_t1, FlowResult& 
   }
   if (!ws_) ws_ = std::make_unique<Workspace>();
   const int levels = flow_pyramid_levels(frame_t.size(), params_, options);
-  build_pyramid(frame_t, levels, params_.sigma, ws_->pyr_t);
-  build_pyramid(frame_t1, levels, params_.sigma, ws_->pyr_t1);
+  // The two pyramids side by side when there are threads for it.
+  const cv::Mat* frames[] = {&frame_t, &frame_t1};
+  Pyramid* pyramids[] = {&ws_->pyr_t, &ws_->pyr_t1};
+  auto build = [&](int b, int e) {
+    for (int i = b; i < e; ++i)
+      build_pyramid(*frames[i], levels, params_.sigma, *pyramids[i]);
+  };
+  if (executor_ && executor_->concurrency() > 1) {
+    executor_->for_range(0, 2, 1, build);
+  } else {
+    build(0, 2);
+  }
   flow_from_pyramids(ws_->pyr_t, ws_->pyr_t1, params_, result, options, executor_, *ws_);
 }
 

@@ -42,7 +42,7 @@ enum class Derivative {
 
 struct LkParams {
   int patch = 10;      // window side in pixels, 3..31, even sizes allowed (see above)
-  int levels = 3;      // pyramid levels, 1..6 (fewer when the image is small)
+  int levels = 3;      // pyramid levels, 1..6 (fewer when the image is small); 0 = auto
   int iterations = 3;  // refinement iterations per level, 1..50
   double sigma = 0.5;  // pretreatment Gaussian sigma in pixels, 0 = off
   Derivative derivative = Derivative::HornSchunck;
@@ -54,10 +54,32 @@ struct LkParams {
   double robust_scale = 0.0;
   int level_median = 0;  // median filter (0 off, 3, 5) of the flow after each coarse level
   int final_median = 0;  // median filter (0 off, 3, 5) of the final flow
+  // Large displacements (large_motion.hpp). levels = 0 (auto) picks the levels from the frame
+  // size and the expected motion: the coarsest level keeps a shorter side of coarsest_side
+  // pixels (12..480).
+  double expected_motion = 0.0;  // level-0 pixels, >= 0; 0 = a quarter of the larger side
+  int coarsest_side = 40;
+  // Coarse search at the coarsest level: the largest radius, in that level's pixels
+  // (0 = off, at most kMaxSearchRadius); the radius used covers the expected motion.
+  int search_radius = 0;
+  // Candidate fusion before the iterations of a level: each pixel may take the flow of the
+  // pixels fuse_far_step, then fuse_step, away (that level's pixels; 0 = off, at most 32), on
+  // the levels from fuse_far_finest_level and fuse_finest_level up to the coarsest.
+  int fuse_far_step = 0;
+  int fuse_far_finest_level = 0;
+  int fuse_step = 0;
+  int fuse_finest_level = 0;
+  // Samples of frame t+1 that fall outside the frame carry no brightness term (It = 0): the
+  // pixels moving out of view keep the flow their neighbours give them.
+  bool mask_outside = false;
+  // Level LK stops at (as FlowOptions::finest_level, which can only raise it): the finer
+  // levels get the upsampled flow. 0..kMaxLevels - 1.
+  int finest_level = 0;
 
   static LkParams paper();     // patch 10, levels 3, iterations 3, Horn–Schunck
   static LkParams accurate();  // tuned for the lowest error on real data
-  // "paper" or "accurate"; throws roiflow::Error naming the unknown preset.
+  static LkParams fast();      // realtime with large motions: search, fusion, LK to level 1
+  // "paper", "accurate" or "fast"; throws roiflow::Error naming the unknown preset.
   static LkParams preset(std::string_view name);
   static std::vector<std::string> preset_names();
 
@@ -136,6 +158,9 @@ class DenseLK {
   const Executor* executor() const { return executor_; }
   void set_executor(const Executor* executor) { executor_ = executor; }
 
+  // Allocates (and touches) the workspace for frames of `size` now, so that the next calc of that
+  // size allocates nothing: timing a single pair then measures the flow, not the page faults.
+  void reserve(cv::Size size, const FlowOptions& options = {});
   // Frees the workspace now (the next calc allocates it again), as
   // cv::DenseOpticalFlow::collectGarbage does.
   void collectGarbage();

@@ -1,20 +1,20 @@
 // One pyramid level of dense LK (internal to roiflow::flow): the window geometry, the level's
-// problem (images, computed rectangle, weights), the `iterations` refinement passes over it and
-// the x2 upsampling of a level's flow onto the next finer one. dense_lk.cpp plans the levels and
-// calls these coarse to fine; the row kernels are in lk_rows.hpp.
+// problem (images, computed rectangle, weights), where its first iteration's flow comes from,
+// and the `iterations` refinement passes over it, split in row bands for the executor. The row
+// kernels are lk_kernels.hpp's; dense_lk.cpp plans the levels and calls these coarse to fine.
 //
-//   LevelScratch scratch;  // row buffers, kept across levels and calls
-//   iterate_level(problem, u, v, u_next, v_next, &confidence, 3, SerialExecutor(), scratch);
+//   LevelScratch scratch;  // band buffers, kept across levels and calls
+//   iterate_level(problem, LevelInput::constant(0.f, 0.f), u, v, &conf, 3, serial, scratch);
 #pragma once
 
-#include <atomic>
+#include <cstddef>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <vector>
 
-#include "flow/dense_lk.hpp"
 #include "core/executor.hpp"
-#include "flow/lk_rows.hpp"
+#include "flow/dense_lk.hpp"
+#include "flow/lk_kernels.hpp"
 
 namespace roiflow::flow::detail {
 
@@ -40,56 +40,57 @@ struct LevelProblem {
   Window win;
   float lambda = 0.f;
   float robust_inv_scale2 = 0.f;  // 1 / robust_scale^2, 0 = least squares
-  std::vector<float> inv_cx;      // 1 / horizontal window weight per column
-  std::vector<float> cy;          // vertical window weight per row
+  bool mask_outside = false;      // LkParams::mask_outside
 };
 
-// Row buffers of one pass over rows; they keep their capacity, so the levels and calls that
-// reuse them allocate nothing.
-struct RowScratch {
-  WarpedRow warp_cache[4];
-  std::vector<float> ring, colsum, col, prefix;
-  std::size_t bytes() const;
+// The flow the first iteration of a level starts from, over its computed rectangle.
+struct LevelInput {
+  enum class Kind { Constant, Planes, Coarser };
+  Kind kind = Kind::Constant;
+  float u = 0.f, v = 0.f;       // Constant
+  const cv::Mat* pu = nullptr;  // Planes: CV_32F, the computed rectangle's size;
+  const cv::Mat* pv = nullptr;  // Coarser: the coarser level's flow, upsampled x2
+  cv::Point coarse_origin;      // Coarser: where pu, pv lie in their level
+
+  static LevelInput constant(float u, float v);
+  static LevelInput planes(const cv::Mat& u, const cv::Mat& v);
+  static LevelInput coarser(const cv::Mat& u, const cv::Mat& v, cv::Point origin);
 };
 
-// The row buffers of a level's passes: one per iteration of the serial wavefront, and a pool
-// that concurrent stripes borrow from.
-class LevelScratch {
+// 64-byte aligned floats, zero when first allocated; they keep their capacity.
+class AlignedFloats {
  public:
-  RowScratch& wavefront(int iteration);
-  // A pool of at least `n` free scratches for stripes running at once; call before they start.
-  void reserve_stripes(int n);
-  std::size_t bytes() const;
-
-  // A stripe's scratch for as long as it lives (bodies never share one).
-  class Lease {
-   public:
-    explicit Lease(LevelScratch& owner);
-    ~Lease();
-    Lease(const Lease&) = delete;
-    Lease& operator=(const Lease&) = delete;
-    RowScratch& operator*() const { return *scratch_; }
-
-   private:
-    LevelScratch& owner_;
-    int slot_ = -1;
-    std::unique_ptr<RowScratch> own_;  // when the pool is exhausted
-    RowScratch* scratch_ = nullptr;
-  };
+  float* reserve(std::size_t n);
+  std::size_t bytes() const { return capacity_ * sizeof(float); }
 
  private:
-  std::vector<std::unique_ptr<RowScratch>> wavefront_;
-  std::vector<std::unique_ptr<RowScratch>> stripes_;
-  std::unique_ptr<std::atomic<bool>[]> busy_;
-  int busy_size_ = 0;
+  std::unique_ptr<float[]> storage_;
+  float* data_ = nullptr;
+  std::size_t capacity_ = 0;
 };
 
-// `iterations` refinement passes over the level: reads the flow (u, v: planar, comp-sized),
-// leaves the refined flow in (u, v) (u_next, v_next are the ping-pong buffers), and the
-// smallest eigenvalue of each window's structure tensor in `confidence` when it is not null.
-void iterate_level(const LevelProblem& p, cv::Mat& u, cv::Mat& v, cv::Mat& u_next, cv::Mat& v_next,
+// The buffers of the row bands of a level (one set per band), kept across levels and calls.
+struct LevelScratch {
+  struct Band {
+    AlignedFloats input, rings, rows;
+  };
+  std::vector<Band> bands;
+  std::vector<float> inv_cx, cy;
+  std::size_t bytes() const;
+};
+
+// Length of the rows of every flow plane of a level `w` wide (its padding, see FlowRows).
+int padded_width(int w);
+
+// `iterations` refinement passes over the level from `input`, into u and v (CV_32F planes of
+// comp.height rows padded_width(comp.width) long, created here: view the first comp.width
+// columns) and, when not null, the smallest eigenvalue of each window's structure tensor into
+// `confidence` (the same shape). With `flow` (CV_32FC2, comp-sized), the flow goes there
+// interleaved instead, u and v are left alone, and `confidence` is comp-sized too. Row bands
+// run on the executor; the result is the same for any split.
+void iterate_level(const LevelProblem& p, const LevelInput& input, cv::Mat& u, cv::Mat& v,
                    cv::Mat* confidence, int iterations, const Executor& executor,
-                   LevelScratch& scratch);
+                   LevelScratch& scratch, cv::Mat* flow = nullptr);
 
 // Flow component of the coarser level (origin `src_origin` in its level) resampled onto
 // rectangle `dst` of the finer level and doubled.

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "flow/lk_kernels.hpp"
 
 namespace roiflow::flow {
 
@@ -33,17 +34,13 @@ cv::Size level_size(cv::Size size, int level) {
 namespace {
 
 // Row y of `image` (8-bit, 16-bit or float gray) scaled to [0, 1] into dst[0 .. cols).
-void unit_row(const cv::Mat& image, int y, float* __restrict dst) {
+void unit_row(const detail::LkKernels& kernels, const cv::Mat& image, int y, float* dst) {
   const int w = image.cols;
   switch (image.depth()) {
-    case CV_8U: {
-      const std::uint8_t* __restrict src = image.ptr<std::uint8_t>(y);
-      for (int x = 0; x < w; ++x)
-        dst[x] = static_cast<float>(src[x]) * (1.f / 255.f);
-      break;
-    }
+    case CV_8U:
+      return kernels.unit_row_u8(image.ptr<std::uint8_t>(y), w, dst);
     case CV_16U: {
-      const std::uint16_t* __restrict src = image.ptr<std::uint16_t>(y);
+      const std::uint16_t* src = image.ptr<std::uint16_t>(y);
       for (int x = 0; x < w; ++x)
         dst[x] = static_cast<float>(src[x]) * (1.f / 65535.f);
       break;
@@ -53,57 +50,33 @@ void unit_row(const cv::Mat& image, int y, float* __restrict dst) {
   }
 }
 
-// Horizontal pass of one row: t[x] = sum_j k[j] p[x + j], p padded with R pixels each side.
-// The kernel is symmetric; a compile-time radius keeps each output's taps in registers.
-template <int R>
-void filter_row(const float* __restrict p, const float* __restrict k, int w, float* __restrict t) {
-  for (int x = 0; x < w; ++x) {
-    float acc = k[R] * p[x + R];
-    for (int j = 0; j < R; ++j)
-      acc += k[j] * (p[x + j] + p[x + 2 * R - j]);
-    t[x] = acc;
-  }
-}
-
-// Vertical pass of one output row from the 2R + 1 filtered rows rows[0 .. 2R].
-template <int R>
-void filter_column(const float* const* rows, const float* __restrict k, int w,
-                   float* __restrict o) {
-  for (int x = 0; x < w; ++x) {
-    float acc = k[R] * rows[R][x];
-    for (int j = 0; j < R; ++j)
-      acc += k[j] * (rows[j][x] + rows[2 * R - j][x]);
-    o[x] = acc;
-  }
-}
-
-// The pretreatment for a kernel of radius R: `image` in [0, 1], smoothed by the separable
+// The pretreatment for a kernel of radius R (1..4): `image` in [0, 1], smoothed by the separable
 // Gaussian `k` (2R + 1 taps, borders replicated), in one pass over the rows: each row is scaled
 // and filtered horizontally into a ring of 2R + 1 rows, and each output row is the vertical sum
 // over the ring. Each output pixel depends only on its neighbourhood, never on where the image
 // (a part of a frame) starts, so pyramids of parts of a frame equal the whole frame's inside
 // them.
-template <int R>
-void smooth_to_unit_float(const cv::Mat& image, const float* k, cv::Mat& out) {
-  constexpr int kTaps = 2 * R + 1;
+void smooth_to_unit_float(const cv::Mat& image, const float* k, int R, cv::Mat& out) {
+  const detail::LkKernels& kernels = detail::lk_kernels();
+  const int taps = 2 * R + 1;
   const int w = image.cols, h = image.rows;
   std::vector<float> padded(static_cast<std::size_t>(w + 2 * R));
-  std::vector<float> ring(static_cast<std::size_t>(kTaps) * w);
-  auto filtered = [&](int row) { return ring.data() + static_cast<std::size_t>(row % kTaps) * w; };
-  const float* rows[kTaps];
+  std::vector<float> ring(static_cast<std::size_t>(taps) * w);
+  auto filtered = [&](int row) { return ring.data() + static_cast<std::size_t>(row % taps) * w; };
+  const float* rows[9];
   out.create(h, w, CV_32F);
-  int next = 0;  // rows [0, next) are filtered (the ring holds the last kTaps of them)
+  int next = 0;  // rows [0, next) are filtered (the ring holds the last `taps` of them)
   for (int y = 0; y < h; ++y) {
     for (; next <= std::min(h - 1, y + R); ++next) {
       float* p = padded.data();
-      unit_row(image, next, p + R);
+      unit_row(kernels, image, next, p + R);
       std::fill(p, p + R, p[R]);
       std::fill(p + R + w, p + 2 * R + w, p[R + w - 1]);
-      filter_row<R>(p, k, w, filtered(next));
+      kernels.smooth_h(p, k, R, w, filtered(next));
     }
-    for (int j = 0; j < kTaps; ++j)
+    for (int j = 0; j < taps; ++j)
       rows[j] = filtered(std::clamp(y - R + j, 0, h - 1));
-    filter_column<R>(rows, k, w, out.ptr<float>(y));
+    kernels.smooth_v(rows, k, R, w, out.ptr<float>(y));
   }
 }
 
@@ -131,21 +104,12 @@ void base_level(const cv::Mat& image, double sigma, cv::Mat& out) {
   const int ksize = sigma > 0.0 ? std::max(3, cvRound(sigma * 8 + 1) | 1) : 0;
   if (ksize > 0 && ksize / 2 <= 4) {
     const cv::Mat kernel = cv::getGaussianKernel(ksize, sigma, CV_32F);
-    const float* k = kernel.ptr<float>();
-    switch (ksize / 2) {
-      case 1:
-        return smooth_to_unit_float<1>(gray, k, out);
-      case 2:
-        return smooth_to_unit_float<2>(gray, k, out);
-      case 3:
-        return smooth_to_unit_float<3>(gray, k, out);
-      default:
-        return smooth_to_unit_float<4>(gray, k, out);
-    }
+    return smooth_to_unit_float(gray, kernel.ptr<float>(), ksize / 2, out);
   }
   out.create(gray.size(), CV_32F);
+  const detail::LkKernels& kernels = detail::lk_kernels();
   for (int y = 0; y < gray.rows; ++y)
-    unit_row(gray, y, out.ptr<float>(y));
+    unit_row(kernels, gray, y, out.ptr<float>(y));
   if (ksize > 0) {
     cv::GaussianBlur(out, out, cv::Size(ksize, ksize), sigma, sigma, cv::BORDER_REPLICATE);
   }

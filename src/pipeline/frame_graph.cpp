@@ -396,7 +396,10 @@ RunReport run_dense(const FrameSource& source, const flow::LkParams& params,
   return run_in_arena(options, [&](int limit, Clock::time_point start) {
     Run run(options);
     tf::graph g;
-    FrontEnd front(g, run, source, limit, params.levels, params.sigma);
+    // The frame size comes with the first frame: build the levels the largest frame would need
+    // (a pyramid stops where its frame is too small, and dense_flow uses what it asks for).
+    const int pyramid_levels = flow::flow_pyramid_levels({1 << 16, 1 << 16}, params, {});
+    FrontEnd front(g, run, source, limit, pyramid_levels, params.sigma);
 
     struct PairJob {
       long long seq = 0;

@@ -96,7 +96,7 @@ TEST(DenseLkTest, RejectsEveryParameterOutOfRange) {
   const Case cases[] = {
       {"patch", "2", [](LkParams& p) { p.patch = 2; }},
       {"patch", "32", [](LkParams& p) { p.patch = 32; }},
-      {"levels", "0", [](LkParams& p) { p.levels = 0; }},
+      {"levels", "-1", [](LkParams& p) { p.levels = -1; }},
       {"levels", "7", [](LkParams& p) { p.levels = 7; }},
       {"iterations", "0", [](LkParams& p) { p.iterations = 0; }},
       {"iterations", "51", [](LkParams& p) { p.iterations = 51; }},
@@ -106,6 +106,14 @@ TEST(DenseLkTest, RejectsEveryParameterOutOfRange) {
       {"robust", "-0.1", [](LkParams& p) { p.robust_scale = -0.1; }},
       {"median", "4", [](LkParams& p) { p.level_median = 4; }},
       {"median", "7", [](LkParams& p) { p.final_median = 7; }},
+      {"expected motion", "-1", [](LkParams& p) { p.expected_motion = -1; }},
+      {"search radius", "25", [](LkParams& p) { p.search_radius = 25; }},
+      {"fuse step", "33", [](LkParams& p) { p.fuse_step = 33; }},
+      {"fuse far step", "-1", [](LkParams& p) { p.fuse_far_step = -1; }},
+      {"fuse far finest level", "6", [](LkParams& p) { p.fuse_far_finest_level = 6; }},
+      {"coarsest side", "11", [](LkParams& p) { p.coarsest_side = 11; }},
+      {"fuse finest level", "6", [](LkParams& p) { p.fuse_finest_level = 6; }},
+      {"finest level", "-1", [](LkParams& p) { p.finest_level = -1; }},
   };
   const cv::Mat frame(24, 32, CV_8UC1, cv::Scalar(9));
   for (const Case& c : cases) {
@@ -161,11 +169,11 @@ TEST(DenseLkTest, TinyImagesGiveFiniteFlowOfTheRightSize) {
       EXPECT_TRUE(all_finite(moved.confidence)) << c.name << " " << size;
 
       // Not exactly zero: the warp interpolates the last column and row with weight 1 on the
-      // far sample, p00 + 1 * (p01 - p00), which can miss p01 by an ulp (measured up to
-      // 1.5e-8 px, at 13x13 with Scharr).
+      // far sample, p00 + 1 * (p01 - p00), which can miss p01 by an ulp, and in a window of a
+      // few pixels lambda barely damps it (measured up to 1.7e-7 px, at 2x2 with Scharr).
       const FlowResult still = dense_flow(a, a, c.params);
       ASSERT_EQ(still.flow.size(), size);
-      EXPECT_LT(cv::norm(still.flow, cv::NORM_INF), 1e-7) << c.name << " " << size;
+      EXPECT_LT(cv::norm(still.flow, cv::NORM_INF), 1e-6) << c.name << " " << size;
     }
   }
 }

@@ -25,12 +25,13 @@ expect() {  # expect pass|fail DESCRIPTION COMMAND...
   fi
 }
 
-# --- eval_gate.sh: a stub whose `eval` prints $work/eval.csv
+# --- eval_gate.sh: a stub whose `eval DIR` prints $work/eval_<folder of DIR>.csv; the cases
+# below spoil middlebury's, the other datasets keep good figures.
 data="$work/data"
-mkdir -p "$data/middlebury" "$work/stub"
+mkdir -p "$data/middlebury" "$data/kitti" "$data/sintel" "$data/flyingchairs" "$work/stub"
 cat >"$work/stub/roiflow" <<STUB
 #!/usr/bin/env bash
-if [[ \$1 == eval ]]; then cat "$work/eval.csv"; exit 0; fi
+if [[ \$1 == eval ]]; then cat "$work/eval_\$(basename "\$2").csv"; exit 0; fi
 if [[ \$1 == track ]]; then
   while [[ \$# -gt 0 ]]; do
     case \$1 in
@@ -45,15 +46,25 @@ exec "$real_bin" "\$@"
 STUB
 chmod +x "$work/stub/roiflow"
 
-eval_csv() {  # eval_csv ROWS MEAN_ROW [ROW_EPE]
+dataset_csv() {  # dataset_csv FOLDER ROWS AAE EPE: every row and the mean alike
   {
     echo "sequence,aae_deg,epe,r1,r3,ms"
-    for ((i = 0; i < $1; ++i)); do echo "seq$i,5.000,${3:-0.4000},1.0,1.0,10.0"; done
+    for ((i = 0; i < $2; ++i)); do echo "seq$i,$3,$4,1.0,1.0,10.0"; done
+    echo "mean,$3,$4,1.0,1.0,10.0"
+  } >"$work/eval_$1.csv"
+}
+dataset_csv kitti 2 15.000 10.0000
+dataset_csv sintel 4 15.000 10.0000
+dataset_csv flyingchairs 6 10.000 3.0000
+eval_csv() {  # eval_csv ROWS MEAN_ROW [ROW_EPE]: middlebury's
+  {
+    echo "sequence,aae_deg,epe,r1,r3,ms"
+    for ((i = 0; i < $1; ++i)); do echo "seq$i,5.000,${3:-0.3500},1.0,1.0,10.0"; done
     echo "$2"
-  } >"$work/eval.csv"
+  } >"$work/eval_middlebury.csv"
 }
 gate() { "$repo/scripts/eval_gate.sh" "$data" "$work/stub"; }
-eval_csv 8 "mean,5.000,0.4000,1.0,1.0,10.0"
+eval_csv 8 "mean,5.000,0.3500,1.0,1.0,10.0"
 expect pass "eval gate, good figures" gate
 eval_csv 8 "mean,,,,,"
 expect fail "eval gate, empty mean row" gate
@@ -61,7 +72,7 @@ eval_csv 8 "mean,nan,nan,nan,nan,nan"
 expect fail "eval gate, nan mean row" gate
 eval_csv 8 "mean,-nan,-nan,1.0,1.0,10.0"
 expect fail "eval gate, -nan mean row" gate
-eval_csv 7 "mean,5.000,0.4000,1.0,1.0,10.0"
+eval_csv 7 "mean,5.000,0.3500,1.0,1.0,10.0"
 expect fail "eval gate, a sequence dropped" gate
 eval_csv 8 "mean,5.000,0.3000,1.0,1.0,10.0"
 expect fail "eval gate, mean not the rows' mean" gate
@@ -69,15 +80,20 @@ eval_csv 8 "mean,5.000,0.9000,1.0,1.0,10.0" 0.9000
 expect fail "eval gate, EPE above its gate" gate
 {
   echo "sequence,aae_deg,epe,r1,r3,ms"
-  for ((i = 0; i < 7; ++i)); do echo "seq$i,5.000,0.4000,1.0,1.0,10.0"; done
-  echo "seq7,inf,0.4000,1.0,1.0,10.0"
-  echo "mean,5.000,0.4000,1.0,1.0,10.0"
-} >"$work/eval.csv"
+  for ((i = 0; i < 7; ++i)); do echo "seq$i,5.000,0.3500,1.0,1.0,10.0"; done
+  echo "seq7,inf,0.3500,1.0,1.0,10.0"
+  echo "mean,5.000,0.3500,1.0,1.0,10.0"
+} >"$work/eval_middlebury.csv"
 expect fail "eval gate, inf in a row" gate
 rm -rf "$data/middlebury"
-eval_csv 8 "mean,5.000,0.4000,1.0,1.0,10.0"
+eval_csv 8 "mean,5.000,0.3500,1.0,1.0,10.0"
 expect fail "eval gate, dataset folder missing" gate
 mkdir -p "$data/middlebury"
+dataset_csv sintel 3 15.000 10.0000  # a Sintel pair dropped
+expect fail "eval gate, a Sintel pair dropped" gate
+dataset_csv sintel 4 15.000 12.5000  # above accurate's gate
+expect fail "eval gate, Sintel EPE above its gate" gate
+dataset_csv sintel 4 15.000 10.0000
 
 # --- track_gate.sh: the stub writes $work/track.csv as the log; `score` is the real roiflow.
 seq="$work/seq"

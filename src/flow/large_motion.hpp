@@ -1,0 +1,91 @@
+// Large displacements for dense LK: how many pyramid levels a frame gets, a coarse search that
+// starts the coarsest level inside LK's basin when objects move further than a patch, and a
+// candidate fusion that carries a motion found in one part of an object over to the rest.
+//
+//   using namespace roiflow::flow;
+//   const int levels = auto_levels({1242, 375}, /*expected_motion=*/0.0);      // 4 levels
+//   cv::Mat u(i0.size(), CV_32F, 0.f), v(i0.size(), CV_32F, 0.f);
+//   search_flow(i0, i1, {0.f, 0.f}, SearchParams{.radius = 12}, u, v);         // coarsest level
+//   fuse_candidates(i0, i1, /*step=*/6, /*window=*/7, u, v);                   // any level
+//
+// LK linearises the brightness equation, so it converges only when its starting flow is off by
+// less than about a window's reach at the level it starts on: pyramid levels alone reach a
+// motion of a few pixels times 2^levels, but the coarsest levels of a small frame are a few
+// dozen pixels wide and a patch there covers whole objects. The coarse search instead matches
+// every pixel of a level that keeps object detail (shorter side >= 40 px) over a range of
+// displacements, and keeps a match only when it is reliable:
+// - zero-mean SSD over a window (DIS's mean normalisation: a brightness change between the
+//   frames, as KITTI's exposure or Sintel's fog, does not move the minimum);
+// - forward-backward consistency: searching frame t+1 in frame t must lead back to the pixel
+//   (within `fb_tolerance`), which rejects occluded pixels and repeated texture;
+// - it must beat the prior (the motion assumed before the search) by `prior_margin` of the
+//   prior's cost, which rejects matches in flat areas where any displacement fits.
+// An unreliable pixel takes, of the prior and the flow of its nearest reliable pixel, the one
+// whose window matches better (the prior on a tie). All functions work on CV_32FC1 level images
+// in [0, 1] and planar flow (u, v) in level pixels.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include "flow/dense_lk.hpp"
+
+namespace roiflow::flow {
+
+// The shorter side, in pixels, that auto_levels keeps for the coarsest level by default.
+inline constexpr int kCoarsestSide = 40;
+// The largest search radius LkParams accept, in pixels of the coarsest level.
+inline constexpr int kMaxSearchRadius = 24;
+// The window of the candidate fusion dense_flow runs (LkParams::fuse_step).
+inline constexpr int kFuseWindow = 7;
+
+// Levels for a frame of `size` (LkParams::levels = 0): the coarsest level is the deepest whose
+// shorter side keeps `coarsest_side` pixels (at least kMinLevelSide), so that a search there
+// still sees objects; when `expected_motion` (> 0, level-0 pixels) is small, fewer levels, as
+// long as the coarsest still sees the motion as at most two of its pixels. 1..kMaxLevels.
+int auto_levels(cv::Size size, double expected_motion, int coarsest_side = kCoarsestSide);
+
+// The search radius, in pixels of coarsest level `level`, that covers `expected_motion`
+// (level-0 pixels; <= 0: a quarter of the frame's larger side), at most `max_radius`.
+int search_radius_for(cv::Size size, int level, double expected_motion, int max_radius);
+
+struct SearchParams {
+  int radius = 12;            // displacements -radius..radius on each axis around the prior
+  int window = 7;             // odd side of the window the cost is summed over
+  float fb_tolerance = 1.f;   // forward-backward mismatch still consistent, level pixels
+  float prior_margin = 0.2f;  // share of the prior's cost a match must save (0 = any)
+};
+
+// Coarse search of `i0`'s pixels in `i1` (same size as i0, u and v) around `prior` (level
+// pixels): u, v become each pixel's reliable integer displacement, or its fill (see above).
+// Frame borders are replicated. Throws roiflow::Error on mismatched inputs or parameters out
+// of range (radius 1..kMaxSearchRadius, window odd 3..15, tolerance >= 0, margin in [0, 1)).
+void search_flow(const cv::Mat& i0, const cv::Mat& i1, cv::Point2f prior,
+                 const SearchParams& params, cv::Mat& u, cv::Mat& v);
+
+// Candidate fusion: each pixel keeps its own flow or takes that of the pixel `step` away in
+// one of the 8 directions, whichever has the smallest zero-mean SSD over a `window` x `window`
+// window (frame t+1 warped bilinearly, borders replicated); ties keep the pixel's own. One pass,
+// all pixels at once. Throws roiflow::Error on mismatched inputs, step < 1 or a window that is
+// not odd in 3..15.
+void fuse_candidates(const cv::Mat& i0, const cv::Mat& i1, int step, int window, cv::Mat& u,
+                     cv::Mat& v);
+
+namespace detail {
+
+// The levels `params` asks for at frame size `size`: params.levels, or auto_levels when it is 0.
+int requested_levels(cv::Size size, const LkParams& params);
+
+// Whether seed_level does anything at level `level` of `levels` for `params` and `options`.
+bool seeds_level(const LkParams& params, int level, int levels, const FlowOptions& options);
+
+// dense_flow's hook before the iterations of level `level` (of `levels`; i0, i1: its whole
+// images), on the rectangle `c` that u and v cover: the coarse search at the coarsest level
+// (around options.initial_motion; not when options.initial_flow gives the start), then the far
+// and the near candidate fusion, as `params` ask. A region is searched within its own
+// rectangle.
+void seed_level(const LkParams& params, const cv::Mat& i0, const cv::Mat& i1, const cv::Rect& c,
+                int level, int levels, const FlowOptions& options, cv::Mat& u, cv::Mat& v);
+
+}  // namespace detail
+
+}  // namespace roiflow::flow

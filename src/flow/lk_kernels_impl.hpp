@@ -1,0 +1,455 @@
+// The row kernels of dense LK (warp, Horn–Schunck pairs, window terms and sums, prefix sums,
+// 2x2 solve), written once against simd.hpp; lk_band_impl.hpp drives them over the rows of a
+// level. Included by lk_band_impl.hpp only, once per instruction set: everything here has
+// internal linkage, and no standard-library template is used, so the copies built with
+// different instruction sets share no symbol.
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+
+#pragma once
+
+#include "flow/lk_kernels.hpp"
+#include "flow/simd.hpp"
+
+namespace roiflow::flow::detail {
+namespace {
+
+using simd::Native;
+using simd::Scalar;
+using Idx = std::ptrdiff_t;
+
+constexpr int kChannels = 5;  // gxx, gxy, gyy, bx, by
+constexpr int kPad = 16;      // floats before and after each warped row (64 bytes)
+
+int imin(int a, int b) {
+  return a < b ? a : b;
+}
+int imax(int a, int b) {
+  return a < b ? b : a;
+}
+int floor_to(int v, int step) {
+  return v >= 0 ? v / step * step : -((-v + step - 1) / step) * step;
+}
+Idx round_up(Idx v, Idx step) {
+  return (v + step - 1) / step * step;
+}
+
+float* row_u(const FlowRows& f, int r) {
+  return f.u + ((r - f.first) & f.mask) * f.stride;
+}
+float* row_v(const FlowRows& f, int r) {
+  return f.v + ((r - f.first) & f.mask) * f.stride;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Warp: frame t+1 sampled bilinearly at x + flow(x) (border replicated); m = (I0 + I1w) / 2,
+// d = I1w - I0.
+
+struct WarpGeometry {
+  const float* base;
+  Idx step;
+  float xhi, yhi;
+  int ixmax, iymax;
+  int dx1, dy1;  // offsets of the right and lower neighbours (0 on a one-pixel side)
+};
+
+template <class S>
+ROIFLOW_INLINE void warp_block(const WarpGeometry& g, float fx0, float fy, const float* u,
+                               const float* v, const float* i0, float* m, float* d,
+                               bool may_load_rows) {
+  using F = typename S::F;
+  using I = typename S::I;
+  const F zero = S::set1(0.f);
+  const F sx =
+      S::min(S::max(S::add(S::add(S::set1(fx0), S::iota()), S::load(u)), zero), S::set1(g.xhi));
+  const F sy = S::min(S::max(S::add(S::set1(fy), S::load(v)), zero), S::set1(g.yhi));
+  const I ix = S::mini(S::cvtt(sx), S::seti(g.ixmax));
+  const I iy = S::mini(S::cvtt(sy), S::seti(g.iymax));
+  const F fx = S::sub(sx, S::cvt(ix));
+  const F fyv = S::sub(sy, S::cvt(iy));
+  const I idx = S::addi(S::muli(iy, S::seti(static_cast<std::int32_t>(g.step))), ix);
+  F p00, p01, p10, p11;
+  const std::int32_t k0 = S::first(idx);
+  if (may_load_rows && S::all(S::eqi(idx, S::addi(S::seti(k0), S::iotai())))) {
+    // One row segment: the taps are four plain loads (the common case, smooth flow).
+    const float* p = g.base + k0;
+    p00 = S::load(p);
+    p01 = S::load(p + 1);
+    p10 = S::load(p + g.step);
+    p11 = S::load(p + g.step + 1);
+  } else {
+    p00 = S::gather(g.base, idx);
+    p01 = S::gather(g.base, S::addi(idx, S::seti(g.dx1)));
+    p10 = S::gather(g.base, S::addi(idx, S::seti(g.dy1)));
+    p11 = S::gather(g.base, S::addi(idx, S::seti(g.dy1 + g.dx1)));
+  }
+  const F top = S::madd(fx, S::sub(p01, p00), p00);
+  const F bot = S::madd(fx, S::sub(p11, p10), p10);
+  const F w1 = S::madd(fyv, S::sub(bot, top), top);
+  const F a = S::load(i0);
+  S::store(m, S::mul(S::set1(0.5f), S::add(a, w1)));
+  S::store(d, S::sub(w1, a));
+}
+
+// Row y of the level (global), columns [x0, x1) of the rectangle (x1 <= w) into m, d (indexed
+// from the rectangle's column 0), and the replicated columns m[-1] (with column 0) and m[w]
+// (with column w - 1), d likewise.
+void warp_row(const LevelJob& L, int y, const float* u, const float* v, float* m, float* d, int x0,
+              int x1) {
+  WarpGeometry g;
+  g.base = L.i1;
+  g.step = L.i1_step;
+  g.xhi = static_cast<float>(L.cols - 1);
+  g.yhi = static_cast<float>(L.rows - 1);
+  g.ixmax = imax(0, L.cols - 2);
+  g.iymax = imax(0, L.rows - 2);
+  g.dx1 = L.cols > 1 ? 1 : 0;
+  g.dy1 = L.rows > 1 ? static_cast<int>(L.i1_step) : 0;
+  const bool rows_ok = L.cols > 1 && L.rows > 1;
+  const float* i0 = L.i0 + static_cast<Idx>(y) * L.i0_step + L.x0;
+  const float fy = static_cast<float>(y);
+  constexpr int N = Native::N;
+  int x = x0;
+  for (; x + N <= x1; x += N) {
+    warp_block<Native>(g, static_cast<float>(L.x0 + x), fy, u + x, v + x, i0 + x, m + x, d + x,
+                       rows_ok);
+  }
+  for (; x < x1; ++x) {
+    warp_block<Scalar>(g, static_cast<float>(L.x0 + x), fy, u + x, v + x, i0 + x, m + x, d + x,
+                       false);
+  }
+  if (L.mask_outside) {
+    // A pixel whose sample left the frame asks for no change of its flow (It = 0) instead of
+    // being pulled towards the replicated border.
+    for (x = x0; x < x1; ++x) {
+      const float sx = static_cast<float>(L.x0 + x) + u[x], sy = fy + v[x];
+      const bool outside = sx < 0.f || sx > g.xhi || sy < 0.f || sy > g.yhi;
+      m[x] = outside ? i0[x] : m[x];
+      d[x] = outside ? 0.f : d[x];
+    }
+  }
+  if (x0 == 0) {
+    m[-1] = m[0];
+    d[-1] = d[0];
+  }
+  if (x1 == L.w) {
+    m[L.w] = m[L.w - 1];
+    d[L.w] = d[L.w - 1];
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// One output row: the window terms of the derivative-grid row that enters the vertical window
+// (Ix², IxIy, Iy², Ix·r, Iy·r with r = Ix·ū + Iy·v̄ − It, the brightness equation linearised
+// around the local flow, weighted by 1 / (1 + It² / s²) when robust) are stored in the ring and
+// added into the vertical running sums, whose horizontal prefix sums give each window's sums as
+// one difference; then the regularised 2x2 system (G + lambda I) w = b + lambda w_old of each
+// pixel is solved, G and b the window means.
+//
+// Layouts, chosen so that the loops address everything from a few pointers with constant
+// offsets and whole-vector aligned loads: the ring rows and the vertical sums hold the five
+// channels of each vector of columns together ([vector][channel][lane]); the prefix sums and
+// half-weight columns are planar, because the solve reads them at any column offset.
+
+enum Deriv { kHornSchunck = 0, kScharr = 1, kCentral = 2, kOutside = 3 };
+
+// Interleaved rows: channel c of the vector at column x.
+ROIFLOW_INLINE float* at(float* row, int x, int c) {
+  return row + kChannels * x + c * Native::N;
+}
+ROIFLOW_INLINE const float* at(const float* row, int x, int c) {
+  return row + kChannels * x + c * Native::N;
+}
+
+// Horn–Schunck works on the 2x2x2 cube between warped rows s, s + 1 and columns x, x + 1 (grid
+// at +1/2). Each warped row's column pairs are formed once (it serves two derivative-grid rows):
+// Dm = m[x+1] - m[x], Sm = m[x] + m[x+1], Sd, Su, Sv likewise (interleaved like the ring). Flow
+// rows: column w holds column w - 1, so x + 1 is the replicated neighbour at the last column.
+void hs_pairs(int x0, int x1, const float* m, const float* d, const float* u, const float* v,
+              float* pairs) {
+  using S = Native;
+  for (int x = x0; x < x1; x += S::N) {
+    const S::F m0 = S::load(m + x), m1 = S::load(m + x + 1);
+    S::store(at(pairs, x, 0), S::sub(m1, m0));
+    S::store(at(pairs, x, 1), S::add(m0, m1));
+    S::store(at(pairs, x, 2), S::add(S::load(d + x), S::load(d + x + 1)));
+    S::store(at(pairs, x, 3), S::add(S::load(u + x), S::load(u + x + 1)));
+    S::store(at(pairs, x, 4), S::add(S::load(v + x), S::load(v + x + 1)));
+  }
+}
+
+// The rows the entering derivative-grid row s is made of. Horn–Schunck: the pairs of warped rows
+// s (pa) and s + 1 (pb). Grid stencils: warped rows s - 1, s, s + 1 (m0, m1, m2) and row s's d,
+// u, v.
+struct TermRows {
+  const float *pa = nullptr, *pb = nullptr;
+  const float *m0 = nullptr, *m1 = nullptr, *m2 = nullptr;
+  const float *d1 = nullptr, *u1 = nullptr, *v1 = nullptr;
+};
+
+template <int kDeriv, bool kRobust>
+ROIFLOW_INLINE void products(const TermRows& t, int x, Native::F inv_s2, Native::F* p) {
+  using S = Native;
+  using F = S::F;
+  if constexpr (kDeriv == kOutside) {
+    for (int c = 0; c < kChannels; ++c)
+      p[c] = S::set1(0.f);
+    return;
+  } else {
+    F ix, iy, it, ub, vb;
+    if constexpr (kDeriv == kHornSchunck) {
+      const F half = S::set1(0.5f), quarter = S::set1(0.25f);
+      ix = S::mul(half, S::add(S::load(at(t.pa, x, 0)), S::load(at(t.pb, x, 0))));
+      iy = S::mul(half, S::sub(S::load(at(t.pb, x, 1)), S::load(at(t.pa, x, 1))));
+      it = S::mul(quarter, S::add(S::load(at(t.pa, x, 2)), S::load(at(t.pb, x, 2))));
+      ub = S::mul(quarter, S::add(S::load(at(t.pa, x, 3)), S::load(at(t.pb, x, 3))));
+      vb = S::mul(quarter, S::add(S::load(at(t.pa, x, 4)), S::load(at(t.pb, x, 4))));
+    } else if constexpr (kDeriv == kScharr) {
+      const F k = S::set1(1.f / 32.f), three = S::set1(3.f), ten = S::set1(10.f);
+      const F hx =
+          S::madd(three, S::sub(S::load(t.m2 + x + 1), S::load(t.m2 + x - 1)),
+                  S::madd(ten, S::sub(S::load(t.m1 + x + 1), S::load(t.m1 + x - 1)),
+                          S::mul(three, S::sub(S::load(t.m0 + x + 1), S::load(t.m0 + x - 1)))));
+      const F hy =
+          S::madd(three, S::sub(S::load(t.m2 + x + 1), S::load(t.m0 + x + 1)),
+                  S::madd(ten, S::sub(S::load(t.m2 + x), S::load(t.m0 + x)),
+                          S::mul(three, S::sub(S::load(t.m2 + x - 1), S::load(t.m0 + x - 1)))));
+      ix = S::mul(k, hx);
+      iy = S::mul(k, hy);
+      it = S::load(t.d1 + x);
+      ub = S::load(t.u1 + x);
+      vb = S::load(t.v1 + x);
+    } else {
+      const F half = S::set1(0.5f);
+      ix = S::mul(half, S::sub(S::load(t.m1 + x + 1), S::load(t.m1 + x - 1)));
+      iy = S::mul(half, S::sub(S::load(t.m2 + x), S::load(t.m0 + x)));
+      it = S::load(t.d1 + x);
+      ub = S::load(t.u1 + x);
+      vb = S::load(t.v1 + x);
+    }
+    F wix = ix, wiy = iy;
+    if constexpr (kRobust) {
+      const F wgt = S::recip(S::madd(S::mul(it, it), inv_s2, S::set1(1.f)));
+      wix = S::mul(wgt, ix);
+      wiy = S::mul(wgt, iy);
+    }
+    const F r = S::sub(S::madd(iy, vb, S::mul(ix, ub)), it);
+    p[0] = S::mul(wix, ix);
+    p[1] = S::mul(wix, iy);
+    p[2] = S::mul(wiy, iy);
+    p[3] = S::mul(wix, r);
+    p[4] = S::mul(wiy, r);
+  }
+}
+
+// Row s enters the window: its terms into the ring slot `ring` (which holds the leaving row's
+// terms when kLeaving) and the vertical sums; with kPrefix, the sums' horizontal prefix sums
+// (of the half-weight column sums when `top`, the window's first ring row, is given: `ring` is
+// then its last) into `prefix` (planar, `pstride` apart) and the column sums into `col`.
+template <int kDeriv, bool kRobust, bool kLeaving, bool kPrefix, bool kHalf>
+void enter_row_t(int x0, int x1, const TermRows& rows, float inv_s2_value, float* ring, float* acc,
+                 const float* top, float* col, Idx col_stride, float* prefix, Idx pstride,
+                 float* carry_mem) {
+  using S = Native;
+  using F = S::F;
+  const TermRows t = rows;  // a local: the stores below could alias `rows`
+  const F inv_s2 = S::set1(inv_s2_value), half = S::set1(0.5f);
+  F carry[kChannels];
+  for (int c = 0; c < kChannels; ++c)
+    carry[c] = S::load(carry_mem + c * S::N);
+  for (int x = x0; x < x1; x += S::N) {
+    F term[kChannels];
+    products<kDeriv, kRobust>(t, x, inv_s2, term);
+    for (int c = 0; c < kChannels; ++c) {
+      float* rc = at(ring, x, c);
+      float* ac = at(acc, x, c);
+      const F old = S::load(ac);
+      const F sum = kLeaving ? S::add(old, S::sub(term[c], S::load(rc))) : S::add(old, term[c]);
+      S::store(rc, term[c]);
+      S::store(ac, sum);
+      if constexpr (kPrefix) {
+        F column = sum;
+        if constexpr (kHalf) {
+          // Column sums with the two end rows at weight 1/2.
+          column = S::nmadd(half, S::add(S::load(at(top, x, c)), term[c]), column);
+          S::store(col + c * col_stride + x, column);
+        }
+        const F ps = S::add(S::prefix(column), carry[c]);
+        S::store(prefix + c * pstride + x, ps);
+        carry[c] = S::last(ps);
+      }
+    }
+  }
+  for (int c = 0; c < kChannels; ++c)
+    S::store(carry_mem + c * S::N, carry[c]);
+}
+
+// Fresh window sums: acc = the window's ring rows added top to bottom (then their prefix sums as
+// in enter_row). A running sum's rounding depends on where it started: summing afresh every
+// `stripe` rows makes every row independent of where its pass began.
+void resum_row(int x0, int x1, const float* const* row_list, int count, float* acc,
+               const float* top, const float* bot, float* col, Idx col_stride, float* prefix,
+               Idx pstride, float* carry_mem) {
+  const float* rows[64];
+  for (int r = 0; r < count; ++r)
+    rows[r] = row_list[r];
+  using S = Native;
+  using F = S::F;
+  const F half = S::set1(0.5f);
+  F carry[kChannels];
+  for (int c = 0; c < kChannels; ++c)
+    carry[c] = S::load(carry_mem + c * S::N);
+  for (int x = x0; x < x1; x += S::N) {
+    for (int c = 0; c < kChannels; ++c) {
+      F sum = S::load(at(rows[0], x, c));
+      for (int r = 1; r < count; ++r)
+        sum = S::add(sum, S::load(at(rows[r], x, c)));
+      S::store(at(acc, x, c), sum);
+      F column = sum;
+      if (top) {
+        column = S::nmadd(half, S::add(S::load(at(top, x, c)), S::load(at(bot, x, c))), column);
+        S::store(col + c * col_stride + x, column);
+      }
+      const F ps = S::add(S::prefix(column), carry[c]);
+      S::store(prefix + c * pstride + x, ps);
+      carry[c] = S::last(ps);
+    }
+  }
+  for (int c = 0; c < kChannels; ++c)
+    S::store(carry_mem + c * S::N, carry[c]);
+}
+
+struct SolveRow {
+  int w;
+  const float* prefix;  // channel c at prefix + c * pstride; window = p[x + hi] - p[x + lo - 1]
+  Idx pstride;
+  const float* col;  // half-weight: subtract half of col[x + lo] and col[x + hi]
+  Idx col_stride;
+  int lo, hi;
+  const float* inv_cx;
+  float inv_cy, lambda;
+  const float *uo, *vo;
+  float *un, *vn, *conf;
+  float* flow;  // non-null: (u, v) interleaved here instead of un, vn (rows not padded)
+};
+
+template <bool kHalf, bool kConfidence, bool kInterleaved>
+void solve_row_t(const SolveRow& q, int x0, int x1) {
+  using S = Native;
+  using F = S::F;
+  // Locals, not q's fields: the stores below could alias q, and the compiler would reload every
+  // field per vector.
+  const float* p[kChannels];
+  const float* col[kChannels];
+  for (int c = 0; c < kChannels; ++c) {
+    p[c] = q.prefix + c * q.pstride + q.hi;
+    col[c] = kHalf ? q.col + c * q.col_stride : nullptr;
+  }
+  const Idx span = q.hi - q.lo + 1;  // from p[x + lo - 1] to p[x + hi]
+  const int lo = q.lo, hi = q.hi;
+  const float* inv_cx = q.inv_cx;
+  const float *uo = q.uo, *vo = q.vo;
+  float *un = q.un, *vn = q.vn, *conf = q.conf, *flow = q.flow;
+  const int w = q.w;
+  const F lambda = S::set1(q.lambda), inv_cy = S::set1(q.inv_cy), half = S::set1(0.5f);
+  // Whole vectors: the lanes past w land in the rows' padding.
+  for (int x = x0; x < x1; x += S::N) {
+    F s[kChannels];
+    for (int c = 0; c < kChannels; ++c) {
+      s[c] = S::sub(S::load(p[c] + x), S::load(p[c] + x - span));
+      if constexpr (kHalf) {
+        s[c] = S::nmadd(half, S::add(S::load(col[c] + x + lo), S::load(col[c] + x + hi)), s[c]);
+      }
+    }
+    const F n = S::mul(S::load(inv_cx + x), inv_cy);
+    const F gxx = S::mul(s[0], n), gxy = S::mul(s[1], n), gyy = S::mul(s[2], n);
+    const F a = S::add(gxx, lambda), dd = S::add(gyy, lambda);
+    const F ex = S::madd(s[3], n, S::mul(lambda, S::load(uo + x)));
+    const F ey = S::madd(s[4], n, S::mul(lambda, S::load(vo + x)));
+    const F inv_det = S::recip(S::nmadd(gxy, gxy, S::mul(a, dd)));
+    const F nu = S::mul(S::nmadd(gxy, ey, S::mul(dd, ex)), inv_det);
+    const F nv = S::mul(S::nmadd(gxy, ex, S::mul(a, ey)), inv_det);
+    F cf = S::set1(0.f);
+    if constexpr (kConfidence) {
+      const F hd = S::mul(half, S::sub(gxx, gyy));
+      const F root = S::sqrt(S::madd(hd, hd, S::mul(gxy, gxy)));
+      cf = S::max(S::set1(0.f), S::sub(S::mul(half, S::add(gxx, gyy)), root));
+    }
+    if constexpr (kInterleaved) {
+      F first, second;
+      S::zip(nu, nv, first, second);
+      if (x + S::N <= w) {
+        S::store(flow + 2 * x, first);
+        S::store(flow + 2 * x + S::N, second);
+        if constexpr (kConfidence) S::store(conf + x, cf);
+      } else {
+        // The rows of the result end at w: the last vector's lanes go one by one.
+        alignas(64) float pairs[2 * S::N], conf_lanes[S::N];
+        S::store(pairs, first);
+        S::store(pairs + S::N, second);
+        S::store(conf_lanes, cf);
+        for (int i = 0; x + i < w; ++i) {
+          flow[2 * (x + i)] = pairs[2 * i];
+          flow[2 * (x + i) + 1] = pairs[2 * i + 1];
+          if constexpr (kConfidence) conf[x + i] = conf_lanes[i];
+        }
+      }
+    } else {
+      S::store(un + x, nu);
+      S::store(vn + x, nv);
+      if constexpr (kConfidence) S::store(conf + x, cf);
+    }
+  }
+}
+
+template <bool kHalf>
+void solve_row_h(const SolveRow& q, int x0, int x1) {
+  if (q.flow) {
+    if (q.conf) return solve_row_t<kHalf, true, true>(q, x0, x1);
+    return solve_row_t<kHalf, false, true>(q, x0, x1);
+  }
+  if (q.conf) return solve_row_t<kHalf, true, false>(q, x0, x1);
+  solve_row_t<kHalf, false, false>(q, x0, x1);
+}
+
+void solve_row(const SolveRow& q, int x0, int x1) {
+  if (x0 >= x1) return;
+  if (q.col) return solve_row_h<true>(q, x0, x1);
+  solve_row_h<false>(q, x0, x1);
+}
+
+using EnterFn = void (*)(int, int, const TermRows&, float, float*, float*, const float*, float*,
+                         Idx, float*, Idx, float*);
+
+template <int kDeriv, bool kRobust, bool kLeaving>
+EnterFn pick_enter_output(bool prefix, bool half) {
+  if (!prefix) return enter_row_t<kDeriv, kRobust, kLeaving, false, false>;
+  return half ? enter_row_t<kDeriv, kRobust, kLeaving, true, true>
+              : enter_row_t<kDeriv, kRobust, kLeaving, true, false>;
+}
+
+template <int kDeriv, bool kRobust>
+EnterFn pick_enter_flags(bool leaving, bool prefix, bool half) {
+  return leaving ? pick_enter_output<kDeriv, kRobust, true>(prefix, half)
+                 : pick_enter_output<kDeriv, kRobust, false>(prefix, half);
+}
+
+EnterFn pick_enter(int deriv, bool robust, bool leaving, bool prefix, bool half) {
+  switch (deriv) {
+    case kHornSchunck:
+      return robust ? pick_enter_flags<kHornSchunck, true>(leaving, prefix, half)
+                    : pick_enter_flags<kHornSchunck, false>(leaving, prefix, half);
+    case kScharr:
+      return robust ? pick_enter_flags<kScharr, true>(leaving, prefix, half)
+                    : pick_enter_flags<kScharr, false>(leaving, prefix, half);
+    case kCentral:
+      return robust ? pick_enter_flags<kCentral, true>(leaving, prefix, half)
+                    : pick_enter_flags<kCentral, false>(leaving, prefix, half);
+    default:
+      return pick_enter_flags<kOutside, false>(leaving, prefix, half);
+  }
+}
+
+}  // namespace
+}  // namespace roiflow::flow::detail
