@@ -4,8 +4,8 @@
 // elsewhere). Everything crossing this boundary is a plain struct of numbers and pointers, so
 // that no inline function is compiled with two instruction sets.
 //
-//   const LkKernels& k = lk_kernels();
-//   k.run_band(job);   // the iterations of one level over rows [job.begin, job.end)
+//   const roiflow::flow::detail::LkKernels& k = roiflow::flow::detail::lk_kernels();
+//   const int lanes = k.lanes;  // 16 with AVX-512 ("avx512" == k.name), 8 with AVX2, 4 else
 #pragma once
 
 #include <cstddef>

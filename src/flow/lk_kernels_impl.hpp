@@ -243,6 +243,24 @@ ROIFLOW_INLINE void products(const TermRows& t, int x, Native::F inv_s2, Native:
   }
 }
 
+// The output of the vertical sum `sum` of vector x, channel c: the column sum (less half of the
+// window's two end rows with kHalf: `top` its first ring row, `bottom` the last row's term) into
+// `col`, and its prefix sum, plus `carry` (the sums of the vectors before), into `prefix`.
+template <bool kHalf>
+ROIFLOW_INLINE void prefix_out(Native::F sum, Native::F bottom, const float* top, int x, int c,
+                               float* col, Idx col_stride, float* prefix, Idx pstride,
+                               Native::F& carry) {
+  using S = Native;
+  Native::F column = sum;
+  if constexpr (kHalf) {
+    column = S::nmadd(S::set1(0.5f), S::add(S::load(at(top, x, c)), bottom), column);
+    S::store(col + c * col_stride + x, column);
+  }
+  const Native::F ps = S::add(S::prefix(column), carry);
+  S::store(prefix + c * pstride + x, ps);
+  carry = S::last(ps);
+}
+
 // Row s enters the window: its terms into the ring slot `ring` (which holds the leaving row's
 // terms when kLeaving) and the vertical sums; with kPrefix, the sums' horizontal prefix sums
 // (of the half-weight column sums when `top`, the window's first ring row, is given: `ring` is
@@ -254,7 +272,7 @@ void enter_row_t(int x0, int x1, const TermRows& rows, float inv_s2_value, float
   using S = Native;
   using F = S::F;
   const TermRows t = rows;  // a local: the stores below could alias `rows`
-  const F inv_s2 = S::set1(inv_s2_value), half = S::set1(0.5f);
+  const F inv_s2 = S::set1(inv_s2_value);
   F carry[kChannels];
   for (int c = 0; c < kChannels; ++c)
     carry[c] = S::load(carry_mem + c * S::N);
@@ -269,15 +287,7 @@ void enter_row_t(int x0, int x1, const TermRows& rows, float inv_s2_value, float
       S::store(rc, term[c]);
       S::store(ac, sum);
       if constexpr (kPrefix) {
-        F column = sum;
-        if constexpr (kHalf) {
-          // Column sums with the two end rows at weight 1/2.
-          column = S::nmadd(half, S::add(S::load(at(top, x, c)), term[c]), column);
-          S::store(col + c * col_stride + x, column);
-        }
-        const F ps = S::add(S::prefix(column), carry[c]);
-        S::store(prefix + c * pstride + x, ps);
-        carry[c] = S::last(ps);
+        prefix_out<kHalf>(sum, term[c], top, x, c, col, col_stride, prefix, pstride, carry[c]);
       }
     }
   }
@@ -296,7 +306,6 @@ void resum_row(int x0, int x1, const float* const* row_list, int count, float* a
     rows[r] = row_list[r];
   using S = Native;
   using F = S::F;
-  const F half = S::set1(0.5f);
   F carry[kChannels];
   for (int c = 0; c < kChannels; ++c)
     carry[c] = S::load(carry_mem + c * S::N);
@@ -306,14 +315,12 @@ void resum_row(int x0, int x1, const float* const* row_list, int count, float* a
       for (int r = 1; r < count; ++r)
         sum = S::add(sum, S::load(at(rows[r], x, c)));
       S::store(at(acc, x, c), sum);
-      F column = sum;
       if (top) {
-        column = S::nmadd(half, S::add(S::load(at(top, x, c)), S::load(at(bot, x, c))), column);
-        S::store(col + c * col_stride + x, column);
+        prefix_out<true>(sum, S::load(at(bot, x, c)), top, x, c, col, col_stride, prefix, pstride,
+                         carry[c]);
+      } else {
+        prefix_out<false>(sum, sum, top, x, c, col, col_stride, prefix, pstride, carry[c]);
       }
-      const F ps = S::add(S::prefix(column), carry[c]);
-      S::store(prefix + c * pstride + x, ps);
-      carry[c] = S::last(ps);
     }
   }
   for (int c = 0; c < kChannels; ++c)

@@ -3,8 +3,9 @@
 // and the `iterations` refinement passes over it, split in row bands for the executor. The row
 // kernels are lk_kernels.hpp's; dense_lk.cpp plans the levels and calls these coarse to fine.
 //
-//   LevelScratch scratch;  // band buffers, kept across levels and calls
-//   iterate_level(problem, LevelInput::constant(0.f, 0.f), u, v, &conf, 3, serial, scratch);
+//   using namespace roiflow::flow::detail;
+//   const Window w = make_window(10, /*half_pixel_grid=*/true);  // Horn–Schunck: lo -5, hi 4
+//   LevelScratch scratch;  // band buffers, kept across levels and calls by iterate_level
 #pragma once
 
 #include <cstddef>

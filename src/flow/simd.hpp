@@ -5,9 +5,10 @@
 // anonymous namespace: the kernel file is compiled once per instruction set (lk_kernels_*.cpp) and
 // no inline function may be shared between those copies.
 //
-//   using V = simd::Native;                 // or simd::Scalar for tails
-//   V::F a = V::load(p), b = V::set1(2.f);
-//   V::store(q, V::madd(a, b, a));          // a * b + a, fused where the ISA has FMA
+//   using V = roiflow::flow::simd::Native;  // or simd::Scalar for tails
+//   float in[16] = {1.f}, out[16];
+//   V::store(out, V::madd(V::load(in), V::set1(2.f), V::load(in)));  // in * 2 + in, fused
+//                                                                     // where the ISA has FMA
 //
 // OpenCV's universal intrinsics would serve the 128-bit kinds, but an application built outside
 // OpenCV gets only their SSE2/NEON width from the installed headers (cv_cpu_dispatch.h's

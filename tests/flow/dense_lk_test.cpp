@@ -1,5 +1,6 @@
 // Dense LK's contract without ground truth: bad input, parameters, presets, tiny images.
 #include "flow/dense_lk.hpp"
+#include "flow/lk_kernels.hpp"
 
 #include <gtest/gtest.h>
 
@@ -176,6 +177,34 @@ TEST(DenseLkTest, TinyImagesGiveFiniteFlowOfTheRightSize) {
       EXPECT_LT(cv::norm(still.flow, cv::NORM_INF), 1e-6) << c.name << " " << size;
     }
   }
+}
+
+// The dispatch picks the widest kernels this CPU runs: NEON on arm64 (scripts/arm64.sh runs this
+// under qemu), on x86-64 AVX-512 or AVX2 + FMA where the CPU has them, else SSE2.
+TEST(LkKernelsTest, TheBestKindForThisCpu) {
+  const detail::LkKernels& k = detail::lk_kernels();
+#if defined(__aarch64__)
+  EXPECT_STREQ(k.name, "neon");
+  EXPECT_EQ(k.lanes, 4);
+#elif defined(__x86_64__)
+  __builtin_cpu_init();
+  if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
+      __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512dq")) {
+    EXPECT_STREQ(k.name, "avx512");
+    EXPECT_EQ(k.lanes, 16);
+  } else if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
+    EXPECT_STREQ(k.name, "avx2");
+    EXPECT_EQ(k.lanes, 8);
+  } else {
+    EXPECT_STREQ(k.name, "sse2");
+    EXPECT_EQ(k.lanes, 4);
+  }
+#endif
+  const detail::LkKernels* kinds[8];
+  const int n = detail::available_lk_kernels(kinds, 8);
+  ASSERT_GE(n, 1);
+  EXPECT_EQ(kinds[0], &k);  // best first, and the baseline always last
+  EXPECT_GE(kinds[n - 1]->lanes, 1);
 }
 
 TEST(DenseLkTest, RegionOutsideTheFrameThrows) {
