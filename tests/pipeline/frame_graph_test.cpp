@@ -194,6 +194,7 @@ TEST_P(FrameGraphThreads, DensePreparedPartsReachTheirSinkInOrder) {
   constexpr long long kFrames = 24;
   ShiftingSource source({96, 72}, kFrames);
   std::atomic<int> running{0}, most{0};
+  std::atomic<bool> waited{false};
   std::vector<long long> order, plain;
   GraphOptions options;
   options.threads = GetParam();
@@ -210,8 +211,15 @@ TEST_P(FrameGraphThreads, DensePreparedPartsReachTheirSinkInOrder) {
                      int seen = most.load();
                      while (now > seen && !most.compare_exchange_weak(seen, now)) {
                      }
-                     // Long enough for the other threads to be inside too when they can be.
-                     std::this_thread::sleep_for(std::chrono::milliseconds(3));
+                     // The first prepare waits (up to 5 s, on a loaded machine too) for another
+                     // one to start beside it: only a node that runs them one at a time fails.
+                     bool expected = false;
+                     if (GetParam() > 1 && waited.compare_exchange_strong(expected, true)) {
+                       const auto until =
+                           std::chrono::steady_clock::now() + std::chrono::seconds(5);
+                       while (most.load() < 2 && std::chrono::steady_clock::now() < until)
+                         std::this_thread::sleep_for(std::chrono::microseconds(200));
+                     }
                      --running;
                      return cv::Mat(cv::Matx21d(static_cast<double>(p.seq),
                                                 p.flow->flow.at<cv::Vec2f>(10, 10)[0]));
@@ -232,6 +240,27 @@ TEST_P(FrameGraphThreads, DensePreparedPartsReachTheirSinkInOrder) {
   } else {
     EXPECT_EQ(most.load(), 1);
   }
+}
+
+TEST(FrameGraph, AnExceptionInAPrepareEndsADenseRunWithItsMessage) {
+  ShiftingSource source({64, 48}, 200);
+  GraphOptions options;
+  options.threads = 2;
+  std::string message;
+  std::atomic<long long> written{0};
+  finishes([&] {
+    message = error_message([&] {
+      run_dense(std::ref(source), flow::LkParams::paper(),
+                {{"sink", [&](const FlowPair&) { ++written; },
+                  [](const FlowPair& p) {
+                    if (p.seq == 12) throw Error("cannot encode pair 12");
+                    return cv::Mat();
+                  }}},
+                options);
+    });
+  });
+  EXPECT_EQ(message, "cannot encode pair 12");
+  EXPECT_LE(written.load(), 12);  // nothing after the failed pair reaches the ordered writer
 }
 
 // The real tracker without a given target (so the background model is refreshed beside the
