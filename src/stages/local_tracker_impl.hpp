@@ -17,6 +17,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/error.hpp"
+#include "core/text.hpp"
 #include "stages/local_tracker.hpp"
 #include "stages/template_search.hpp"
 
@@ -189,6 +191,14 @@ struct LocalTracker::Impl {
   cv::Mat recent;  // the same, cut at a recent confidently tracked box (empty until then)
   ScaledTemplates templ_sizes, recent_sizes;
   int since_recent = 0;
+  std::vector<cv::Mat> memory;  // earlier confident looks (long-term memory), oldest first
+  std::vector<ScaledTemplates> memory_sizes;
+  int since_memory = 0;
+  // Self-awareness (local_tracker_checks.cpp).
+  bool lost = false;    // the last step left the target lost: the box coasts
+  int lost_frames = 0;  // frames lost in a row
+  double moving = 0;    // recent speed relative to the background (running mean)
+  bool built = false;   // frame t's part is in next_part (this step)
 
   // Buffers reused from frame to frame.
   flow::Pyramid view_prev, view_cur, view_next;
@@ -237,6 +247,9 @@ struct LocalTracker::Impl {
     prev_part.rect = cv::Rect();
     box = b;
     velocity = {0.f, 0.f};
+    lost = false;
+    lost_frames = 0;
+    moving = 0;
   }
 
   // `r` grown to the coarsest level's pixel grid and to at least kMinLevelSide pixels there
@@ -346,9 +359,31 @@ struct LocalTracker::Impl {
     view(next_part, next_part.rect, levels, view_next);
   }
 
+  // One step, in the order track() runs them (local_tracker.cpp).
+  cv::Rect region_for(const cv::Rect2f& predicted_box, int lk_level) const;
+  cv::Point build_step(const LocalFrame& in, const cv::Rect& region, int lk_level);
+  cv::Point2f sample_object(const cv::Rect& object, const cv::Rect& region, double& texture);
+  double backward_check(const cv::Rect& object, cv::Point2f rough, cv::Point origin,
+                        const cv::Rect& part, int lk_level);
+  Appearance look(const LocalFrame& in, const cv::Rect2f& b, double reach);
+  void remember(const LocalFrame& in, double appearance, double inliers);
+  void advance(const LocalFrame& in);
+  LocalResult& lose(LocalResult& r, LostReason why, const cv::Rect2f& predicted_box,
+                    const LocalFrame& in);
+  // Self-awareness (local_tracker_checks.cpp).
+  void measure_background(LocalResult& r, const cv::Rect2f& b) const;
+  LostReason check_flow(const LocalResult& r, double raw_scale) const;
+  LostReason check_state(const LocalResult& r, cv::Point2f motion, const cv::Rect2f& next) const;
+  void learn_motion(const LocalResult& r, cv::Point2f motion);
+  double verify(const LocalFrame& in, const cv::Rect2f& b);
+  // Pixels (level 0) by which a flow must differ from the background's to be the target's.
+  float foreground_tol(int lk_level) const {
+    return static_cast<float>(params.foreground_tolerance * (1 << lk_level));
+  }
+
   Appearance match(const cv::Mat& appearance, ScaledTemplates& sizes, const flow::Pyramid& pyr,
                    cv::Point origin, const cv::Rect2f& b, double reach) const;
-  cv::Point2f measure_motion(double& scale);
+  cv::Point2f measure_motion(const LocalResult& r, double& scale);
   LocalResult track(const LocalFrame& frame);
 };
 

@@ -101,7 +101,18 @@ Appearance LocalTracker::Impl::match(const cv::Mat& appearance, ScaledTemplates&
 
 // Median flow of the inliers, and the median ratio of their pairwise distances (pairs closer
 // than a fifth of the box would make noisy ratios) as `scale`.
-cv::Point2f LocalTracker::Impl::measure_motion(double& scale) {
+cv::Point2f LocalTracker::Impl::measure_motion(const LocalResult& r, double& scale) {
+  // A non-rigid target (limbs that swing) or a thin one (a box mostly background): the pixels
+  // that move unlike the background are the target's, when there are enough of them.
+  if (params.segment && r.background_known && r.foreground > 0) {
+    const float tol = foreground_tol(r.level);
+    std::size_t kept = 0;
+    for (int i : inliers) {
+      const cv::Point2f d = to[i] - from[i] - r.background;
+      if (d.dot(d) > tol * tol) inliers[kept++] = i;
+    }
+    inliers.resize(kept);
+  }
   work_x.clear();
   work_y.clear();
   for (int i : inliers) {
@@ -138,6 +149,75 @@ cv::Point2f LocalTracker::Impl::measure_motion(double& scale) {
   }
   if (work_x.size() >= 8) scale = median(work_x);
   return motion;
+}
+
+// The best match of the target's looks around `b`: the first look, which never drifts, is
+// preferred; the recent one and the remembered ones take over while the object looks different
+// (lighting, pose) and the first no longer matches well.
+Appearance LocalTracker::Impl::look(const LocalFrame& in, const cv::Rect2f& b, double reach) {
+  // The appearance search and the recent appearance's cut read frame t's part beyond LK's (the
+  // whole part built so far, grown where they need more).
+  cv::Rect need = match_need(templ, b, reach);
+  if (!recent.empty()) need |= match_need(recent, b, reach);
+  for (const cv::Mat& m : memory)
+    need |= match_need(m, b, reach);
+  cover(in, need);
+  const cv::Point origin = next_part.rect.tl();
+  Appearance a = match(templ, templ_sizes, view_next, origin, b, reach);
+  if (a.score >= params.trust_appearance) return a;
+  if (!recent.empty()) {
+    const Appearance o = match(recent, recent_sizes, view_next, origin, b, reach);
+    if (o.score > a.score) a = o;
+  }
+  for (std::size_t k = 0; k < memory.size() && a.score < params.trust_appearance; ++k) {
+    const Appearance o = match(memory[k], memory_sizes[k], view_next, origin, b, reach);
+    if (o.score > a.score) a = o;
+  }
+  return a;
+}
+
+// The appearance memory follows the target slowly and only from confident frames: the recent
+// look every template_interval of them, a long-term one every memory_interval (the oldest
+// forgotten beyond `memory`).
+void LocalTracker::Impl::remember(const LocalFrame& in, double appearance, double inlier_share) {
+  ++since_recent;
+  ++since_memory;
+  if (appearance < params.confident_appearance || inlier_share < 0.5) return;
+  if (since_recent >= params.template_interval) {
+    cover(in, grown(enclosing(box), 2));
+    cut(view_next, next_part.rect.tl(), box, recent);
+    recent_sizes.clear();
+    since_recent = 0;
+  }
+  if (params.memory > 0 && since_memory >= params.memory_interval && !recent.empty()) {
+    if (static_cast<int>(memory.size()) >= params.memory) {
+      memory.erase(memory.begin());
+      memory_sizes.erase(memory_sizes.begin());
+    }
+    memory.push_back(recent.clone());
+    memory_sizes.emplace_back();
+    since_memory = 0;
+  }
+}
+
+double LocalTracker::Impl::verify(const LocalFrame& in, const cv::Rect2f& b) {
+  check_frame(in);
+  if (in.gray.size() != size) throw Error("local tracker: verify() on a frame of another size");
+  PartPyramid part;
+  cv::Rect need = match_need(templ, b, 1.0);
+  if (!recent.empty()) need |= match_need(recent, b, 1.0);
+  for (const cv::Mat& m : memory)
+    need |= match_need(m, b, 1.0);
+  build(in.gray, in.pyramid, part_for(need & frame_rect()), part);
+  flow::Pyramid v;
+  view(part, part.rect, levels, v);
+  double best = match(templ, templ_sizes, v, part.rect.tl(), b, 1.0).score;
+  if (!recent.empty()) {
+    best = std::max(best, match(recent, recent_sizes, v, part.rect.tl(), b, 1.0).score);
+  }
+  for (std::size_t k = 0; k < memory.size(); ++k)
+    best = std::max(best, match(memory[k], memory_sizes[k], v, part.rect.tl(), b, 1.0).score);
+  return best;
 }
 
 }  // namespace roiflow::stages
