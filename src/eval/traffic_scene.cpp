@@ -179,7 +179,8 @@ std::vector<MotBox> TrafficScene::boxes(long long i) const {
     MotBox b;
     b.frame = static_cast<int>(i + 1);
     b.id = p.id;
-    b.box = clipped;
+    // MOTChallenge's 1-based pixel coordinates: drawn pixel column 0 is x = 1.
+    b.box = cv::Rect2d(clipped.x + 1, clipped.y + 1, clipped.width, clipped.height);
     out.push_back(b);
   }
   std::sort(out.begin(), out.end(), [](const MotBox& a, const MotBox& b) { return a.id < b.id; });
