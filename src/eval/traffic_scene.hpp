@@ -29,7 +29,9 @@
 // (MOTChallenge also keeps occluded objects). Ids: vehicle v on its first pass is v + 1; its
 // pass number p (from 0) makes it v + 1 + p * objects. Frames are rendered on demand,
 // deterministically (camera noise included), and any frame count works: traffic keeps
-// flowing, which makes long soak inputs.
+// flowing, which makes long soak inputs. Camera noise (Gaussian, whole gray levels) cycles
+// through 16 fields drawn once where they fit in 96 MB (up to about 1080p), else is drawn per
+// frame.
 #pragma once
 
 #include <cstdint>
@@ -99,11 +101,13 @@ class TrafficScene {
   void check_index(long long i) const;
   double driven(const Lane& lane, long long i) const;
   std::vector<Placed> place(long long i) const;
+  cv::Mat noise_field(std::uint64_t stream) const;  // CV_16SC3 camera noise
 
   TrafficSceneParams params_;
   std::vector<Lane> lanes_;
   std::vector<Vehicle> vehicles_;
   cv::Mat background_;
+  std::vector<cv::Mat> noise_bank_;  // cycled camera noise fields (empty: drawn per frame)
 };
 
 }  // namespace roiflow::eval
