@@ -5,6 +5,7 @@
 //   roiflow eval data/middlebury --format csv -o errors.csv
 //   roiflow eval data/sintel/training --pass final --max-pairs 50 --report sintel.html
 //   roiflow score track.csv Car4/groundtruth_rect.txt --format json
+//   roiflow score --mot mot.txt PETS09-S2L1/gt/gt.txt --format json
 //
 // Each subcommand is a thin layer: CLI11 parses, the library computes, this file prints.
 // Failures print one line, `roiflow: error: <message>`, on stderr: exit code 2 for a bad
@@ -137,7 +138,9 @@ void run_flow(const FlowCommand& cmd) {
   std::string written = cmd.output;
   eval::write_flo(cmd.output, result.flow);
   if (!cmd.color.empty()) {
-    eval::write_image_atomically(cmd.color, flow::flow_to_color(result.flow));
+    // Against a ground truth, the truth's largest vector saturates, so the two pictures compare.
+    const float scale = truth.empty() ? -1.f : flow::max_magnitude(truth);
+    eval::write_image_atomically(cmd.color, flow::flow_to_color(result.flow, scale));
     written += ", " + cmd.color;
   }
   if (!cmd.legend.empty()) {
@@ -168,7 +171,10 @@ void add_flow_command(CLI::App& app, FlowCommand& cmd) {
   sub->add_option("-o,--output", cmd.output, "the flow, Middlebury .flo")
       ->type_name("FLO")
       ->required();
-  sub->add_option("--color", cmd.color, "the flow in Middlebury colour coding")->type_name("IMAGE");
+  sub->add_option("--color", cmd.color,
+                  "the flow in Middlebury colour coding, saturated at the 99th percentile of its "
+                  "magnitudes (with --gt: at the truth's largest)")
+      ->type_name("IMAGE");
   sub->add_option("--legend", cmd.legend, "the colour wheel, as a legend")->type_name("IMAGE");
   sub->add_option("--gt", cmd.ground_truth, "ground-truth flow: print the error against it")
       ->type_name("FLO");
@@ -194,8 +200,7 @@ struct EvalCommand {
 };
 
 // `skipped` receives what a partial tree lacks (see eval::find_pairs).
-std::vector<eval::EvalPair> eval_pairs(const EvalCommand& cmd,
-                                         std::vector<std::string>& skipped) {
+std::vector<eval::EvalPair> eval_pairs(const EvalCommand& cmd, std::vector<std::string>& skipped) {
   if (cmd.dir.empty() && cmd.pairs.empty()) {
     throw UsageError(
         "eval needs a Middlebury, Sintel or KITTI directory DIR or at least one --pair A B GT");
@@ -329,9 +334,11 @@ struct ScoreCommand {
   std::string track;
   std::string ground_truth;
   std::string format = "table";
+  bool mot = false;
 };
 
 void run_score(const ScoreCommand& cmd) {
+  if (cmd.mot) return print_mot_score(cmd.track, cmd.ground_truth, cmd.format);
   const std::vector<eval::TrackRecord> records = eval::read_track_csv(cmd.track);
   std::vector<cv::Rect2f> track;
   try {
@@ -373,6 +380,9 @@ void add_score_command(CLI::App& app, ScoreCommand& cmd) {
       ->type_name("FORMAT")
       ->check(CLI::IsMember({"table", "json"}))
       ->capture_default_str();
+  sub->add_flag("--mot", cmd.mot,
+                "multi-object: TRACK and GROUNDTRUTH are MOTChallenge files (GROUNDTRUTH may be "
+                "synthetic:N[:WxH]:OBJECTS); CLEAR-MOT and IDF1");
   sub->callback([&cmd] { run_score(cmd); });
 }
 
@@ -420,6 +430,8 @@ int main(int argc, char** argv) {
   int exit_code = 0;
   add_video_commands(app, exit_code);
   add_sweep_command(app);
+  add_scaling_command(app);
+  add_benchmark_command(app);
 
   try {
     app.parse(argc, argv);
