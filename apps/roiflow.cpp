@@ -377,7 +377,8 @@ void add_score_command(CLI::App& app, ScoreCommand& cmd) {
       ->check(CLI::IsMember({"table", "json"}))
       ->capture_default_str();
   sub->add_flag("--mot", cmd.mot,
-                "multi-object: TRACK and GROUNDTRUTH are MOTChallenge files; CLEAR-MOT and IDF1");
+                "multi-object: TRACK and GROUNDTRUTH are MOTChallenge files (GROUNDTRUTH may be "
+                "synthetic:N[:WxH]:OBJECTS); CLEAR-MOT and IDF1");
   sub->callback([&cmd] { run_score(cmd); });
 }
 
