@@ -426,6 +426,7 @@ int main(int argc, char** argv) {
   int exit_code = 0;
   add_video_commands(app, exit_code);
   add_sweep_command(app);
+  add_scaling_command(app);
   add_benchmark_command(app);
 
   try {

@@ -22,12 +22,16 @@
 // Sizes and speeds scale with min(width / 640, height / 480) (vehicles at least 8 px a side).
 //
 // Ground truth: a vehicle's box is the exact extent of its drawn shape (sub-pixel position,
-// integer size), clipped to the frame; it is listed, with conf 1, in every frame where that
+// integer size), clipped to the frame, in MOTChallenge's 1-based pixel coordinates (a shape
+// drawn from pixel column 0 has x = 1, as MOTChallenge ground truth and roiflow's --mot
+// output count); it is listed, with conf 1, in every frame where that
 // clipped box is at least 8 px on each side, whether or not another vehicle hides part of it
 // (MOTChallenge also keeps occluded objects). Ids: vehicle v on its first pass is v + 1; its
 // pass number p (from 0) makes it v + 1 + p * objects. Frames are rendered on demand,
 // deterministically (camera noise included), and any frame count works: traffic keeps
-// flowing, which makes long soak inputs.
+// flowing, which makes long soak inputs. Camera noise (Gaussian, whole gray levels) cycles
+// through 16 fields drawn once where they fit in 96 MB (up to about 1080p), else is drawn per
+// frame.
 #pragma once
 
 #include <cstdint>
@@ -63,7 +67,7 @@ class TrafficScene {
   // Frame i (0 <= i < frames()) as CV_8UC3 BGR; throws roiflow::Error for another i.
   cv::Mat render(long long i) const;
   // The ground-truth boxes of frame i (MotBox::frame = i + 1), sorted by id.
-  std::vector<MotBox> boxes(long long i) const;
+  std::vector<MotBox> boxes(long long i) const;  // 1-based x, y
   // boxes(i) of every frame, in frame order.
   std::vector<MotBox> ground_truth() const;
   // The static background alone (CV_8UC3), without vehicles and noise.
@@ -97,11 +101,13 @@ class TrafficScene {
   void check_index(long long i) const;
   double driven(const Lane& lane, long long i) const;
   std::vector<Placed> place(long long i) const;
+  cv::Mat noise_field(std::uint64_t stream) const;  // CV_16SC3 camera noise
 
   TrafficSceneParams params_;
   std::vector<Lane> lanes_;
   std::vector<Vehicle> vehicles_;
   cv::Mat background_;
+  std::vector<cv::Mat> noise_bank_;  // cycled camera noise fields (empty: drawn per frame)
 };
 
 }  // namespace roiflow::eval

@@ -91,7 +91,9 @@ TEST(TrafficScene, BoxesAreTheExactExtentOfWhatIsDrawn) {
     cv::cvtColor(diff, changed, cv::COLOR_BGR2GRAY);
     changed = changed > 0;
     cv::Mat covered(frame.size(), CV_8U, cv::Scalar(0));
-    for (const MotBox& b : scene.boxes(i)) {
+    for (MotBox b : scene.boxes(i)) {
+      b.box.x -= 1;  // MOTChallenge coordinates are 1-based
+      b.box.y -= 1;
       // Pixels that a box touches (rounded outwards) may change; the rest may not.
       const cv::Rect r(
           cv::Point(static_cast<int>(std::floor(b.box.x)), static_cast<int>(std::floor(b.box.y))),
@@ -142,10 +144,10 @@ TEST(TrafficScene, SmallAndWideFramesKeepVehiclesInside) {
     for (long long i = 0; i < 60; i += 10) {
       EXPECT_EQ(scene.render(i).size(), size);
       for (const MotBox& b : scene.boxes(i)) {
-        EXPECT_GE(b.box.x, 0);
-        EXPECT_GE(b.box.y, 0);
-        EXPECT_LE(b.box.x + b.box.width, size.width + 1e-9);
-        EXPECT_LE(b.box.y + b.box.height, size.height + 1e-9);
+        EXPECT_GE(b.box.x, 1);  // 1-based
+        EXPECT_GE(b.box.y, 1);
+        EXPECT_LE(b.box.x - 1 + b.box.width, size.width + 1e-9);
+        EXPECT_LE(b.box.y - 1 + b.box.height, size.height + 1e-9);
         EXPECT_GE(b.box.width, 8);
         EXPECT_GE(b.box.height, 8);
       }
