@@ -48,5 +48,6 @@ void check_image_output(const std::string& path, const std::string& option);
 // roiflow track, dense and demo (video_commands.cpp); a run's exit code goes to `exit_code`.
 void add_video_commands(CLI::App& app, int& exit_code);
 void add_sweep_command(CLI::App& app);  // roiflow sweep (sweep_command.cpp)
+void add_batch_command(CLI::App& app, int& exit_code);  // roiflow batch (batch_command.cpp)
 
 }  // namespace roiflow::cli

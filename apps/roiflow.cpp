@@ -420,6 +420,7 @@ int main(int argc, char** argv) {
   int exit_code = 0;
   add_video_commands(app, exit_code);
   add_sweep_command(app);
+  add_batch_command(app, exit_code);
 
   try {
     app.parse(argc, argv);

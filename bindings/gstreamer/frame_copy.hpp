@@ -51,9 +51,8 @@ inline OwnedFrame copy_frame(const GstVideoFrame* frame) {
   planes.u = copy_plane(frame, 1, ch, planes.nv12 ? 2 * cw : cw);
   if (!planes.nv12) planes.v = copy_plane(frame, 2, ch, cw);
   out.gray = stages::yuv_gray(planes);
-  out.picture = std::make_shared<stages::DeferredImage>([planes] {
-    return stages::yuv_to_bgr(planes);
-  });
+  out.picture =
+      std::make_shared<stages::DeferredImage>([planes] { return stages::yuv_to_bgr(planes); });
   return out;
 }
 

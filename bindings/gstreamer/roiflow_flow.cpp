@@ -73,7 +73,9 @@ G_DEFINE_TYPE(GstRoiflowFlow, gst_roiflow_flow, GST_TYPE_VIDEO_FILTER)
 
 namespace {
 
-GstRoiflowFlow* self_of(gpointer p) { return reinterpret_cast<GstRoiflowFlow*>(p); }
+GstRoiflowFlow* self_of(gpointer p) {
+  return reinterpret_cast<GstRoiflowFlow*>(p);
+}
 
 void set_property(GObject* object, guint id, const GValue* value, GParamSpec* pspec) {
   GstRoiflowFlow* self = self_of(object);
@@ -83,9 +85,15 @@ void set_property(GObject* object, guint id, const GValue* value, GParamSpec* ps
     case PROP_PRESET:
       s.preset = g_value_get_string(value) ? g_value_get_string(value) : "paper";
       break;
-    case PROP_THREADS: s.threads = g_value_get_int(value); break;
-    case PROP_MAX_MOTION: s.max_motion = g_value_get_double(value); break;
-    default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
+    case PROP_THREADS:
+      s.threads = g_value_get_int(value);
+      break;
+    case PROP_MAX_MOTION:
+      s.max_motion = g_value_get_double(value);
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
+      break;
   }
   GST_OBJECT_UNLOCK(self);
 }
@@ -95,10 +103,18 @@ void get_property(GObject* object, guint id, GValue* value, GParamSpec* pspec) {
   GST_OBJECT_LOCK(self);
   const Settings& s = *self->settings;
   switch (id) {
-    case PROP_PRESET: g_value_set_string(value, s.preset.c_str()); break;
-    case PROP_THREADS: g_value_set_int(value, s.threads); break;
-    case PROP_MAX_MOTION: g_value_set_double(value, s.max_motion); break;
-    default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
+    case PROP_PRESET:
+      g_value_set_string(value, s.preset.c_str());
+      break;
+    case PROP_THREADS:
+      g_value_set_int(value, s.threads);
+      break;
+    case PROP_MAX_MOTION:
+      g_value_set_double(value, s.max_motion);
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
+      break;
   }
   GST_OBJECT_UNLOCK(self);
 }
@@ -111,8 +127,8 @@ gboolean start(GstBaseTransform* trans) {
   delete self->run;
   self->run = nullptr;
   try {
-    self->run = new Run(flow::LkParams::preset(s.preset),
-                        s.threads == 0 ? hardware_threads() : s.threads);
+    self->run =
+        new Run(flow::LkParams::preset(s.preset), s.threads == 0 ? hardware_threads() : s.threads);
     self->run->max_motion = s.max_motion > 0 ? static_cast<float>(s.max_motion) : -1.f;
   } catch (const Error& e) {
     GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS, ("%s", e.what()), (nullptr));
@@ -177,8 +193,8 @@ GstFlowReturn transform_frame(GstVideoFilter* filter, GstVideoFrame* in, GstVide
     if (GST_BUFFER_FLAG_IS_SET(in->buffer, GST_BUFFER_FLAG_DISCONT)) run->previous.reset();
     if (run->previous && run->previous->size() != size) run->previous.reset();
     const int levels = flow::flow_pyramid_levels(size, run->lk.params(), {});
-    std::shared_ptr<flow::Pyramid> current = run->spare ? run->spare
-                                                        : std::make_shared<flow::Pyramid>();
+    std::shared_ptr<flow::Pyramid> current =
+        run->spare ? run->spare : std::make_shared<flow::Pyramid>();
     run->spare.reset();
     cv::Mat color;
     run->arena.execute([&] {
@@ -220,8 +236,8 @@ void finalize(GObject* object) {
   G_OBJECT_CLASS(gst_roiflow_flow_parent_class)->finalize(object);
 }
 
-constexpr GParamFlags kReadyProp = static_cast<GParamFlags>(
-    G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_READY);
+constexpr GParamFlags kReadyProp =
+    static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_READY);
 
 }  // namespace
 
@@ -236,8 +252,8 @@ static void gst_roiflow_flow_class_init(GstRoiflowFlowClass* klass) {
   gobject_class->finalize = finalize;
   g_object_class_install_property(
       gobject_class, PROP_PRESET,
-      g_param_spec_string("preset", "Preset", "LK parameter set: paper, accurate or fast",
-                          "paper", kReadyProp));
+      g_param_spec_string("preset", "Preset", "LK parameter set: paper, accurate or fast", "paper",
+                          kReadyProp));
   g_object_class_install_property(
       gobject_class, PROP_THREADS,
       g_param_spec_int("threads", "Threads", "Worker threads of the flow (0 = all cores)", 0,
@@ -251,8 +267,8 @@ static void gst_roiflow_flow_class_init(GstRoiflowFlowClass* klass) {
 
   GstCaps* sink = gst_caps_from_string(GST_VIDEO_CAPS_MAKE("{ GRAY8, I420, NV12 }"));
   GstCaps* src = gst_caps_from_string(GST_VIDEO_CAPS_MAKE("BGR"));
-  gst_element_class_add_pad_template(element_class,
-                                     gst_pad_template_new("sink", GST_PAD_SINK, GST_PAD_ALWAYS, sink));
+  gst_element_class_add_pad_template(
+      element_class, gst_pad_template_new("sink", GST_PAD_SINK, GST_PAD_ALWAYS, sink));
   gst_element_class_add_pad_template(element_class,
                                      gst_pad_template_new("src", GST_PAD_SRC, GST_PAD_ALWAYS, src));
   gst_caps_unref(sink);

@@ -112,8 +112,8 @@ std::vector<cv::Rect2f> parse_boxes(const std::string& text) {
     }
     std::string rest;
     if (in >> rest) throw Error("init: expected 4 numbers x,y,w,h per box, got '" + one + "'");
-    boxes.emplace_back(static_cast<float>(v[0]), static_cast<float>(v[1]),
-                       static_cast<float>(v[2]), static_cast<float>(v[3]));
+    boxes.emplace_back(static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2]),
+                       static_cast<float>(v[3]));
   }
   return boxes;
 }
@@ -133,24 +133,42 @@ G_DEFINE_TYPE(GstRoiflowTrack, gst_roiflow_track, GST_TYPE_VIDEO_FILTER)
 
 namespace {
 
-GstRoiflowTrack* self_of(gpointer p) { return reinterpret_cast<GstRoiflowTrack*>(p); }
+GstRoiflowTrack* self_of(gpointer p) {
+  return reinterpret_cast<GstRoiflowTrack*>(p);
+}
 
 void set_property(GObject* object, guint id, const GValue* value, GParamSpec* pspec) {
   GstRoiflowTrack* self = self_of(object);
   GST_OBJECT_LOCK(self);
   Settings& s = *self->settings;
   switch (id) {
-    case PROP_ROI: s.roi = g_value_get_int(value); break;
-    case PROP_MODE: s.mode = static_cast<RoiflowTrackMode>(g_value_get_enum(value)); break;
-    case PROP_THREADS: s.threads = g_value_get_int(value); break;
-    case PROP_INIT: s.init = g_value_get_string(value) ? g_value_get_string(value) : ""; break;
-    case PROP_MAX_LOST: s.max_lost = g_value_get_int(value); break;
-    case PROP_LOG: s.log = g_value_get_string(value) ? g_value_get_string(value) : ""; break;
-    case PROP_DRAW: s.draw = g_value_get_boolean(value); break;
+    case PROP_ROI:
+      s.roi = g_value_get_int(value);
+      break;
+    case PROP_MODE:
+      s.mode = static_cast<RoiflowTrackMode>(g_value_get_enum(value));
+      break;
+    case PROP_THREADS:
+      s.threads = g_value_get_int(value);
+      break;
+    case PROP_INIT:
+      s.init = g_value_get_string(value) ? g_value_get_string(value) : "";
+      break;
+    case PROP_MAX_LOST:
+      s.max_lost = g_value_get_int(value);
+      break;
+    case PROP_LOG:
+      s.log = g_value_get_string(value) ? g_value_get_string(value) : "";
+      break;
+    case PROP_DRAW:
+      s.draw = g_value_get_boolean(value);
+      break;
     case PROP_PRESET:
       s.preset = g_value_get_string(value) ? g_value_get_string(value) : "paper";
       break;
-    default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
+      break;
   }
   GST_OBJECT_UNLOCK(self);
 }
@@ -160,15 +178,33 @@ void get_property(GObject* object, guint id, GValue* value, GParamSpec* pspec) {
   GST_OBJECT_LOCK(self);
   const Settings& s = *self->settings;
   switch (id) {
-    case PROP_ROI: g_value_set_int(value, s.roi); break;
-    case PROP_MODE: g_value_set_enum(value, s.mode); break;
-    case PROP_THREADS: g_value_set_int(value, s.threads); break;
-    case PROP_INIT: g_value_set_string(value, s.init.c_str()); break;
-    case PROP_MAX_LOST: g_value_set_int(value, s.max_lost); break;
-    case PROP_LOG: g_value_set_string(value, s.log.c_str()); break;
-    case PROP_DRAW: g_value_set_boolean(value, s.draw); break;
-    case PROP_PRESET: g_value_set_string(value, s.preset.c_str()); break;
-    default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
+    case PROP_ROI:
+      g_value_set_int(value, s.roi);
+      break;
+    case PROP_MODE:
+      g_value_set_enum(value, s.mode);
+      break;
+    case PROP_THREADS:
+      g_value_set_int(value, s.threads);
+      break;
+    case PROP_INIT:
+      g_value_set_string(value, s.init.c_str());
+      break;
+    case PROP_MAX_LOST:
+      g_value_set_int(value, s.max_lost);
+      break;
+    case PROP_LOG:
+      g_value_set_string(value, s.log.c_str());
+      break;
+    case PROP_DRAW:
+      g_value_set_boolean(value, s.draw);
+      break;
+    case PROP_PRESET:
+      g_value_set_string(value, s.preset.c_str());
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
+      break;
   }
   GST_OBJECT_UNLOCK(self);
 }
@@ -198,8 +234,8 @@ gboolean start(GstBaseTransform* trans) {
   destroy_run(self);
   try {
     auto run = std::make_unique<Run>(s.threads == 0 ? hardware_threads() : s.threads);
-    run->params.tracker.mode = s.mode == kModeGlobal ? stages::TrackMode::Global
-                                                     : stages::TrackMode::Local;
+    run->params.tracker.mode =
+        s.mode == kModeGlobal ? stages::TrackMode::Global : stages::TrackMode::Local;
     run->params.tracker.roi = s.roi;
     run->params.tracker.lk = flow::LkParams::preset(s.preset);
     run->params.init = parse_boxes(s.init);
@@ -272,8 +308,8 @@ void draw_objects(GstVideoFrame* frame, const std::vector<stages::TrackedObject>
     // found: white, lost (the prediction): black; global treatment: thinner
     const int thickness = o.mode == eval::TrackRecord::Mode::Local ? 2 : 1;
     cv::rectangle(luma, box, cv::Scalar(o.lost ? 0 : 255), thickness);
-    cv::putText(luma, std::to_string(o.id), box.tl() + cv::Point(2, 14),
-                cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(o.lost ? 0 : 255), 1);
+    cv::putText(luma, std::to_string(o.id), box.tl() + cv::Point(2, 14), cv::FONT_HERSHEY_SIMPLEX,
+                0.5, cv::Scalar(o.lost ? 0 : 255), 1);
   }
 }
 
@@ -290,16 +326,15 @@ void attach_meta(GstBuffer* buffer, const stages::TrackedObject& o, long long in
       buffer, "roiflow", x0, y0, x1 > x0 ? x1 - x0 : 0, y1 > y0 ? y1 - y0 : 0);
   meta->id = o.id;
   gst_video_region_of_interest_meta_add_param(
-      meta, gst_structure_new("roiflow/track", "id", G_TYPE_INT, o.id, "x", G_TYPE_DOUBLE,
-                              static_cast<double>(o.box.x), "y", G_TYPE_DOUBLE,
-                              static_cast<double>(o.box.y), "w", G_TYPE_DOUBLE,
-                              static_cast<double>(o.box.width), "h", G_TYPE_DOUBLE,
-                              static_cast<double>(o.box.height), "vx", G_TYPE_DOUBLE,
-                              static_cast<double>(o.velocity.x), "vy", G_TYPE_DOUBLE,
-                              static_cast<double>(o.velocity.y), "mode", G_TYPE_STRING,
-                              eval::to_string(o.mode), "lost", G_TYPE_BOOLEAN,
-                              static_cast<gboolean>(o.lost), "frame", G_TYPE_INT64,
-                              static_cast<gint64>(index), nullptr));
+      meta,
+      gst_structure_new(
+          "roiflow/track", "id", G_TYPE_INT, o.id, "x", G_TYPE_DOUBLE, static_cast<double>(o.box.x),
+          "y", G_TYPE_DOUBLE, static_cast<double>(o.box.y), "w", G_TYPE_DOUBLE,
+          static_cast<double>(o.box.width), "h", G_TYPE_DOUBLE, static_cast<double>(o.box.height),
+          "vx", G_TYPE_DOUBLE, static_cast<double>(o.velocity.x), "vy", G_TYPE_DOUBLE,
+          static_cast<double>(o.velocity.y), "mode", G_TYPE_STRING, eval::to_string(o.mode), "lost",
+          G_TYPE_BOOLEAN, static_cast<gboolean>(o.lost), "frame", G_TYPE_INT64,
+          static_cast<gint64>(index), nullptr));
 }
 
 GstFlowReturn transform_frame_ip(GstVideoFilter* filter, GstVideoFrame* frame) {
@@ -307,8 +342,8 @@ GstFlowReturn transform_frame_ip(GstVideoFilter* filter, GstVideoFrame* frame) {
   Run* run = self->run;
   if (run == nullptr) return GST_FLOW_FLUSHING;
   try {
-    if (!run->tracker) run->tracker = std::make_unique<stages::ObjectTracker>(run->params,
-                                                                              &run->executor);
+    if (!run->tracker)
+      run->tracker = std::make_unique<stages::ObjectTracker>(run->params, &run->executor);
     const gst::OwnedFrame owned = gst::copy_frame(frame);
     stages::TrackerInput in;
     in.index = run->index;
@@ -342,8 +377,8 @@ void finalize(GObject* object) {
   G_OBJECT_CLASS(gst_roiflow_track_parent_class)->finalize(object);
 }
 
-constexpr GParamFlags kReadyProp = static_cast<GParamFlags>(
-    G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_READY);
+constexpr GParamFlags kReadyProp =
+    static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_READY);
 
 }  // namespace
 
@@ -391,14 +426,14 @@ static void gst_roiflow_track_class_init(GstRoiflowTrackClass* klass) {
                            kReadyProp));
   g_object_class_install_property(
       gobject_class, PROP_PRESET,
-      g_param_spec_string("preset", "Preset", "LK parameter set: paper, accurate or fast",
-                          "paper", kReadyProp));
+      g_param_spec_string("preset", "Preset", "LK parameter set: paper, accurate or fast", "paper",
+                          kReadyProp));
 
   GstCaps* caps = gst_caps_from_string(GST_VIDEO_CAPS_MAKE("{ GRAY8, I420, NV12 }"));
-  gst_element_class_add_pad_template(element_class,
-                                     gst_pad_template_new("sink", GST_PAD_SINK, GST_PAD_ALWAYS, caps));
-  gst_element_class_add_pad_template(element_class,
-                                     gst_pad_template_new("src", GST_PAD_SRC, GST_PAD_ALWAYS, caps));
+  gst_element_class_add_pad_template(
+      element_class, gst_pad_template_new("sink", GST_PAD_SINK, GST_PAD_ALWAYS, caps));
+  gst_element_class_add_pad_template(
+      element_class, gst_pad_template_new("src", GST_PAD_SRC, GST_PAD_ALWAYS, caps));
   gst_caps_unref(caps);
   gst_element_class_set_static_metadata(
       element_class, "roiflow tracker", "Filter/Analyzer/Video",

@@ -16,8 +16,8 @@ void check(const YuvPlanes& p) {
   const int cw = (p.y.cols + 1) / 2, ch = (p.y.rows + 1) / 2;
   const bool ok =
       p.y.type() == CV_8UC1 && !p.y.empty() && p.u.type() == CV_8UC1 && p.u.rows >= ch &&
-      (p.nv12 ? p.u.cols >= 2 * cw : (p.u.cols >= cw && p.v.type() == CV_8UC1 && p.v.rows >= ch &&
-                                      p.v.cols >= cw));
+      (p.nv12 ? p.u.cols >= 2 * cw
+              : (p.u.cols >= cw && p.v.type() == CV_8UC1 && p.v.rows >= ch && p.v.cols >= cw));
   if (!ok) {
     throw Error("yuv frame: planes of " + std::to_string(p.y.cols) + "x" +
                 std::to_string(p.y.rows) + " do not form a 4:2:0 frame");
@@ -44,8 +44,7 @@ cv::Mat yuv_to_bgr(const YuvPlanes& p) {
   const AVPixelFormat format = p.nv12 ? AV_PIX_FMT_NV12 : AV_PIX_FMT_YUV420P;
   // SWS_BICUBIC and the source range as VideoDecoder sets them.
   std::unique_ptr<SwsContext, void (*)(SwsContext*)> context(
-      sws_getContext(w, h, format, w, h, AV_PIX_FMT_BGR24, SWS_BICUBIC, nullptr, nullptr,
-                     nullptr),
+      sws_getContext(w, h, format, w, h, AV_PIX_FMT_BGR24, SWS_BICUBIC, nullptr, nullptr, nullptr),
       sws_freeContext);
   if (!context) throw Error("yuv frame: swscale has no conversion to BGR");
   int* inv = nullptr;
@@ -54,8 +53,8 @@ cv::Mat yuv_to_bgr(const YuvPlanes& p) {
   if (sws_getColorspaceDetails(context.get(), &inv, &src_range, &table, &dst_range, &brightness,
                                &contrast, &saturation) >= 0 &&
       src_range != static_cast<int>(p.full_range)) {
-    sws_setColorspaceDetails(context.get(), inv, p.full_range ? 1 : 0, table, dst_range,
-                             brightness, contrast, saturation);
+    sws_setColorspaceDetails(context.get(), inv, p.full_range ? 1 : 0, table, dst_range, brightness,
+                             contrast, saturation);
   }
   cv::Mat bgr(h, w, CV_8UC3);
   const uint8_t* src[4] = {p.y.data, p.u.data, p.nv12 ? nullptr : p.v.data, nullptr};

@@ -20,7 +20,8 @@ namespace roiflow::stages {
 
 struct YuvPlanes {
   cv::Mat y;  // CV_8UC1, w x h
-  cv::Mat u;  // CV_8UC1: I420 Cb, (w+1)/2 x (h+1)/2; NV12: interleaved CbCr, 2 * ((w+1)/2) bytes a row
+  cv::Mat
+      u;  // CV_8UC1: I420 Cb, (w+1)/2 x (h+1)/2; NV12: interleaved CbCr, 2 * ((w+1)/2) bytes a row
   cv::Mat v;  // CV_8UC1: I420 Cr, as u; NV12: unused
   bool nv12 = false;
   bool full_range = false;  // 0..255 (JPEG) rather than 16..235

@@ -34,10 +34,9 @@ class GstEnvironment : public ::testing::Environment {
  public:
   void SetUp() override {
     gst_init(nullptr, nullptr);
-    ASSERT_TRUE(gst_plugin_register_static(GST_VERSION_MAJOR, GST_VERSION_MINOR, "roiflow",
-                                           "roiflow elements (linked statically)",
-                                           roiflow_gst_register, "0.1.0", GST_LICENSE_UNKNOWN,
-                                           "roiflow", "roiflow", "unknown"));
+    ASSERT_TRUE(gst_plugin_register_static(
+        GST_VERSION_MAJOR, GST_VERSION_MINOR, "roiflow", "roiflow elements (linked statically)",
+        roiflow_gst_register, "0.1.0", GST_LICENSE_UNKNOWN, "roiflow", "roiflow", "unknown"));
   }
   void TearDown() override { gst_deinit(); }
 };
@@ -67,8 +66,8 @@ GstBuffer* make_buffer(const cv::Mat& bgr, const char* format, int index) {
   GstVideoFrame frame;
   EXPECT_TRUE(gst_video_frame_map(&frame, &info, buffer, GST_MAP_WRITE));
   const auto plane = [&](int p) {
-    return cv::Mat(GST_VIDEO_FRAME_COMP_HEIGHT(&frame, p), GST_VIDEO_FRAME_COMP_WIDTH(&frame, p) *
-                                                               GST_VIDEO_FRAME_COMP_PSTRIDE(&frame, p),
+    return cv::Mat(GST_VIDEO_FRAME_COMP_HEIGHT(&frame, p),
+                   GST_VIDEO_FRAME_COMP_WIDTH(&frame, p) * GST_VIDEO_FRAME_COMP_PSTRIDE(&frame, p),
                    CV_8UC1, GST_VIDEO_FRAME_PLANE_DATA(&frame, p),
                    static_cast<std::size_t>(GST_VIDEO_FRAME_PLANE_STRIDE(&frame, p)));
   };
@@ -126,8 +125,9 @@ std::vector<Roi> rois(GstBuffer* buffer) {
       int id = 0;
       gboolean lost = FALSE;
       EXPECT_TRUE(gst_structure_get_int(s, "id", &id) && id == r.id);
-      EXPECT_TRUE(gst_structure_get_double(s, "x", &r.bx) && gst_structure_get_double(s, "y", &r.by) &&
-                  gst_structure_get_double(s, "w", &r.bw) && gst_structure_get_double(s, "h", &r.bh));
+      EXPECT_TRUE(
+          gst_structure_get_double(s, "x", &r.bx) && gst_structure_get_double(s, "y", &r.by) &&
+          gst_structure_get_double(s, "w", &r.bw) && gst_structure_get_double(s, "h", &r.bh));
       EXPECT_TRUE(gst_structure_get_double(s, "vx", &r.vx) &&
                   gst_structure_get_double(s, "vy", &r.vy));
       EXPECT_TRUE(gst_structure_get_boolean(s, "lost", &lost));
@@ -155,8 +155,8 @@ class GstTest : public test::TempDirTest {};
 TEST_F(GstTest, TrackMetasEqualObjectTrackerAndLog) {
   const eval::TrackingScene s = scene(30);
   const std::string log = path("track.csv");
-  GstHarness* h = harness("roiflowtrack threads=1 init=\"" + test::box_text(s.box(0)) +
-                          "\" log=" + log);
+  GstHarness* h =
+      harness("roiflowtrack threads=1 init=\"" + test::box_text(s.box(0)) + "\" log=" + log);
   gst_harness_set_src_caps_str(h, caps_text("GRAY8", s.size()).c_str());
 
   // The box as the element parses it from its text.
@@ -213,8 +213,7 @@ TEST_F(GstTest, TrackYuvFormatsAndSeveralBoxes) {
   const eval::TrackingScene s = scene(20);
   for (const char* format : {"I420", "NV12"}) {
     SCOPED_TRACE(format);
-    GstHarness* h = harness("roiflowtrack init=\"" + test::box_text(s.box(0)) +
-                            ";250,180,40,40\"");
+    GstHarness* h = harness("roiflowtrack init=\"" + test::box_text(s.box(0)) + ";250,180,40,40\"");
     gst_harness_set_src_caps_str(h, caps_text(format, s.size()).c_str());
     std::vector<Roi> last;
     for (int i = 0; i < s.frames(); ++i) {
@@ -252,9 +251,9 @@ TEST_F(GstTest, TrackDetectsWithoutInit) {
   ASSERT_GE(first, 0) << "never detected";
   ASSERT_EQ(last.size(), 1u);
   EXPECT_EQ(last[0].id, 1);
-  EXPECT_GT(eval::iou(cv::Rect2f(last[0].bx, last[0].by, last[0].bw, last[0].bh),
-                      s.box(s.frames() - 1)),
-            0.5);
+  EXPECT_GT(
+      eval::iou(cv::Rect2f(last[0].bx, last[0].by, last[0].bw, last[0].bh), s.box(s.frames() - 1)),
+      0.5);
 }
 
 // draw=true paints the boxes into the luma plane; without it the frame passes unchanged.
@@ -471,8 +470,8 @@ std::size_t expect_log_equals_cli(const std::string& video, const std::string& l
     if (i >= records.size()) break;
     want.ms = records[i].ms;
     if (eval::track_csv_row(records[i]) != eval::track_csv_row(want) && differ++ < 3) {
-      ADD_FAILURE() << "frame " << i << ": element " << eval::track_csv_row(records[i])
-                    << " cli " << eval::track_csv_row(want);
+      ADD_FAILURE() << "frame " << i << ": element " << eval::track_csv_row(records[i]) << " cli "
+                    << eval::track_csv_row(want);
     }
     found += !want.lost;
     ++i;
@@ -489,8 +488,8 @@ TEST_F(GstTest, DecodebinPipelineEqualsTheCliTracker) {
   const std::string video = path("scene.avi");
   const eval::TrackingScene s = scene(60);
   {
-    cv::VideoWriter writer(video, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('F', 'M', 'P', '4'),
-                           25.0, s.size());
+    cv::VideoWriter writer(video, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('F', 'M', 'P', '4'), 25.0,
+                           s.size());
     ASSERT_TRUE(writer.isOpened());
     for (int i = 0; i < s.frames(); ++i)
       writer.write(s.render(i));
