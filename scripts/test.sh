@@ -36,3 +36,4 @@ elif [[ ${CI:-} == true ]]; then
 else
   echo "test: WARNING: no GStreamer plugin built: the drop-in gate did NOT run" >&2
 fi
+scripts/benchmark_gate.sh "$data/tracking"
