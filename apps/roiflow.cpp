@@ -425,11 +425,8 @@ int main(int argc, char** argv) {
   int exit_code = 0;
   add_video_commands(app, exit_code);
   add_sweep_command(app);
-<<<<<<< HEAD
-  add_batch_command(app, exit_code);
-=======
   add_benchmark_command(app);
->>>>>>> main
+  add_batch_command(app, exit_code);
 
   try {
     app.parse(argc, argv);

@@ -197,11 +197,12 @@ flow::LkParams lk_params(const std::string& preset, const py::kwargs& kwargs,
   return p;
 }
 
-void check_threads(int threads) {
+int check_threads(int threads) {
   if (threads < 1 || threads > pipeline::kMaxThreads) {
     throw Error("threads must be in 1.." + std::to_string(pipeline::kMaxThreads) + ", got " +
                 std::to_string(threads));
   }
+  return threads;
 }
 
 // ---------------------------------------------------------------------------------- dense flow
@@ -298,8 +299,7 @@ class PyTracker {
  public:
   PyTracker(const py::object& init, const std::string& mode, int roi, int max_lost,
             const std::string& preset, int threads, const py::kwargs& kwargs)
-      : arena_(threads) {
-    check_threads(threads);
+      : arena_(check_threads(threads)) {
     stages::ObjectTrackerParams params;
     params.tracker = tracker_params(mode, roi, preset, kwargs, "Tracker");
     params.init = boxes_from(init);
@@ -345,8 +345,7 @@ class TrackIterator {
   TrackIterator(const std::string& input, const py::object& init, const std::string& mode, int roi,
                 int max_lost, long long start, long long max_frames, const std::string& preset,
                 int threads, const py::kwargs& kwargs)
-      : arena_(threads) {
-    check_threads(threads);
+      : arena_(check_threads(threads)) {
     stages::ObjectTrackerParams params;
     params.tracker = tracker_params(mode, roi, preset, kwargs, "track");
     params.init = boxes_from(init);

@@ -201,6 +201,8 @@ def test_bad_arguments_raise_cli_messages(pair, tmp_path):
         roiflow.Tracker(mode="sideways")
     with pytest.raises(roiflow.Error):
         roiflow.Tracker(roi=2)
+    with pytest.raises(roiflow.Error, match="threads"):
+        roiflow.Tracker(threads=0)
     with pytest.raises(roiflow.Error):
         roiflow.track(str(tmp_path / "missing.avi"))
 
