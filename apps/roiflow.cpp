@@ -377,7 +377,8 @@ void add_score_command(CLI::App& app, ScoreCommand& cmd) {
       ->check(CLI::IsMember({"table", "json"}))
       ->capture_default_str();
   sub->add_flag("--mot", cmd.mot,
-                "multi-object: TRACK and GROUNDTRUTH are MOTChallenge files; CLEAR-MOT and IDF1");
+                "multi-object: TRACK and GROUNDTRUTH are MOTChallenge files (GROUNDTRUTH may be "
+                "synthetic:N[:WxH]:OBJECTS); CLEAR-MOT and IDF1");
   sub->callback([&cmd] { run_score(cmd); });
 }
 
@@ -425,6 +426,7 @@ int main(int argc, char** argv) {
   int exit_code = 0;
   add_video_commands(app, exit_code);
   add_sweep_command(app);
+  add_scaling_command(app);
   add_benchmark_command(app);
   add_batch_command(app, exit_code);
 
