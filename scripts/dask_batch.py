@@ -77,6 +77,29 @@ def run_video(roiflow, video, out, threads, job):
             "stderr": r.stderr.strip().splitlines()[-1] if r.stderr.strip() else ""}
 
 
+def alive(pid):
+    """Whether process `pid` of this host runs (a zombie does not)."""
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except (OSError, IndexError):
+        return False
+
+
+def remove_dead_partials(out, stems):
+    """Partial folders of this host's dead runs (a killed worker's child may die after the retry
+    of its video has already checked): removed, as `roiflow batch` does when it starts."""
+    import socket  # noqa: PLC0415
+
+    host = socket.gethostname().replace(".", "_").replace("/", "_") or "host"
+    for name in os.listdir(out):
+        for s in stems:
+            prefix = f".{s}.partial.{host}."
+            pid = name[len(prefix):]
+            if name.startswith(prefix) and pid.isdigit() and not alive(int(pid)):
+                shutil.rmtree(os.path.join(out, name), ignore_errors=True)
+
+
 def write_csv_atomically(path, rows):
     text = io.StringIO()
     writer = csv.writer(text, lineterminator="\n")
@@ -143,6 +166,7 @@ def main(argv=None):
             print(f"{word} {r['video']}" + (f": {r['stderr']}" if r["returncode"] else ""),
                   flush=True)
 
+    remove_dead_partials(args.out, stems)
     rows, failed = [], 0
     for v in videos:
         status_path = os.path.join(args.out, stem(v), "status.json")
