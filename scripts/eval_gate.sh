@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Accuracy gates on the real optical-flow data: `roiflow eval` per dataset and preset, then the
-# mean EPE and AAE against their gates. Gates are the values measured when they were set (README,
+# mean EPE and AAE against their gates. Gates are the values measured when they were set (docs/ACCURACY.md,
 # "Accuracy") plus about 4 %: enough for compiler and CPU differences, tight enough to catch a
 # real regression. Strict: every row's figures must be finite numbers, the number of rows must
 # be the dataset's (a sequence silently dropped fails), and the mean row must be the mean of the

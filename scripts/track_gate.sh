@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Tracking gate on an OTB sequence (OTB protocol: --init from the first ground-truth box, default
 # settings, then roiflow score): fails when the success AUC or precision@20 falls below its gate.
-# Gates are the values measured when they were set (README, "Tracking") minus a small margin.
+# Gates are the values measured when they were set (docs/LOCAL_TRACKER.md) minus a small margin.
 # Strict: the log must hold one row per ground-truth line, every scored frame must be counted
 # (all ground-truth lines but the absent-target ones), and every figure must be a finite number.
 #
