@@ -1,8 +1,9 @@
 #include "cli_common.hpp"
 
-#include <cstdio>
+#include <algorithm>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
+#include <thread>
 
 #include "flow/large_motion.hpp"
 #include "flow/pyramid.hpp"
@@ -125,14 +126,9 @@ flow::LkParams lk_params(const LkOptions& lk) {
 // ---------------------------------------------------------------------------------------------
 // Output helpers
 
-std::string size_string(cv::Size size) {
-  return std::to_string(size.width) + "x" + std::to_string(size.height);
-}
-
-std::string fixed(double value, int decimals) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
-  return buffer;
+int default_threads() {
+  return std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1,
+                    pipeline::kMaxThreads);
 }
 
 std::string errors_line(const flow::FlowErrors& e) {

@@ -6,12 +6,25 @@
 //   svg += "<text>" + escape_markup(label) + "</text>";
 #pragma once
 
+#include <fmt/format.h>
+
 #include <cstddef>
+#include <opencv2/core/types.hpp>
 #include <sstream>
 #include <string>
 #include <string_view>
 
 namespace roiflow {
+
+// A number with a fixed count of decimals, like printf's "%.*f": fixed(3.14159, 2) is "3.14".
+inline std::string fixed(double value, int decimals) {
+  return fmt::format("{:.{}f}", value, decimals);
+}
+
+// "640x480".
+inline std::string size_text(cv::Size size) {
+  return fmt::format("{}x{}", size.width, size.height);
+}
 
 // A number as error messages show it: the shortest stream form ("0.5", "1e-06", "nan"), so that
 // the value the user gave reads back as they wrote it.

@@ -65,4 +65,7 @@ std::vector<SweepRow> sweep(const std::vector<EvalPair>& pairs, const flow::LkPa
 std::string sweep_value_text(double value);
 // Header `parameter,value,aae_deg,epe,ms_per_pair`; aae 3 decimals, epe 4, ms 2.
 std::string sweep_csv(const std::vector<SweepRow>& rows);
+// The table `roiflow sweep` prints: parameter, value, AAE, EPE, ms per pair.
+std::string sweep_table(const std::vector<SweepRow>& rows);
+
 }  // namespace roiflow::eval

@@ -35,11 +35,22 @@ namespace roiflow::report {
 // platform does not report it. Monotonic: a long run shows whether memory stays flat.
 double peak_rss_mb();
 
+// One stage's totals, as RunStats::totals() reports them.
+struct StageTotal {
+  std::string name;
+  long long calls = 0;
+  double ms_total = 0;
+};
+
+// {"<name>": {"calls", "ms_total", "ms_mean", "fps"}, ...}, the "stages" object of to_json.
+nlohmann::ordered_json stages_json(const std::vector<StageTotal>& stages);
+
 class RunStats {
  public:
   void add(std::string_view stage, double ms);
   void add_frames(long long n);
 
+  std::vector<StageTotal> totals() const;  // first-use order
   nlohmann::ordered_json to_json(double wall_seconds) const;
   // A table for people:
   //   300 frames in 4.21 s: 71.3 fps
@@ -48,11 +59,7 @@ class RunStats {
   std::string format(double wall_seconds) const;
 
  private:
-  struct Stage {
-    std::string name;
-    long long calls = 0;
-    double ms_total = 0;
-  };
+  using Stage = StageTotal;
 
   mutable std::mutex mutex_;
   std::vector<Stage> stages_;  // first-use order; a handful, so a linear search is fastest

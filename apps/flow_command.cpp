@@ -1,0 +1,107 @@
+// roiflow flow: dense flow of one image pair (or a synthetic one) to a .flo file.
+#include <chrono>
+#include <iostream>
+#include <optional>
+
+#include "cli_common.hpp"
+#include "eval/flo_io.hpp"
+#include "eval/flow_input.hpp"
+#include "eval/image_io.hpp"
+#include "flow/color_code.hpp"
+#include "pipeline/tbb_executor.hpp"
+
+namespace roiflow::cli {
+namespace {
+
+const cv::Size kSyntheticSize{640, 480};
+
+struct FlowCommand {
+  LkOptions lk;
+  std::string frame0;
+  std::string frame1;
+  std::string scene;  // set by --synthetic
+  std::string output;
+  std::string color;
+  std::string legend;
+  std::string ground_truth;
+};
+
+void run_flow(const FlowCommand& cmd) {
+  const flow::LkParams params = lk_params(cmd.lk);
+  const bool synthetic = !cmd.scene.empty();
+  if (synthetic && !cmd.frame0.empty()) {
+    throw UsageError("give either two images A B or --synthetic, not both");
+  }
+  if (synthetic && !cmd.ground_truth.empty()) {
+    throw UsageError("--gt: a --synthetic scene brings its own ground truth");
+  }
+  if (!synthetic && cmd.frame1.empty()) {
+    throw UsageError("flow needs two images A B, or --synthetic [scene]");
+  }
+  check_output_path(cmd.output, "-o");
+  if (!cmd.color.empty()) check_image_output(cmd.color, "--color");
+  if (!cmd.legend.empty()) check_image_output(cmd.legend, "--legend");
+  const eval::FlowInput in = synthetic
+                                 ? eval::synthetic_flow_input(cmd.scene, kSyntheticSize)
+                                 : eval::read_flow_input(cmd.frame0, cmd.frame1, cmd.ground_truth);
+
+  const pipeline::TbbExecutor executor;
+  flow::FlowOptions options;
+  const auto start = std::chrono::steady_clock::now();
+  const flow::FlowResult result = pipeline::run_with_threads(cmd.lk.threads, [&] {
+    return flow::dense_flow(in.frame0, in.frame1, params, options, &executor);
+  });
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  // Scored before writing so that a failure here leaves no output behind.
+  std::optional<flow::FlowErrors> errors;
+  if (!in.truth.empty()) {
+    errors = flow::flow_errors(result.flow, in.truth);
+    if (errors->pixels == 0) throw Error("--gt: '" + cmd.ground_truth + "' is unknown everywhere");
+  }
+
+  std::string written = cmd.output;
+  eval::write_flo(cmd.output, result.flow);
+  if (!cmd.color.empty()) {
+    eval::write_image_atomically(cmd.color, flow::flow_to_color(result.flow));
+    written += ", " + cmd.color;
+  }
+  if (!cmd.legend.empty()) {
+    eval::write_image_atomically(cmd.legend, flow::color_wheel_legend());
+    written += ", " + cmd.legend;
+  }
+  std::cout << "flow " << size_text(in.frame0.size()) << " (" << in.source << "): " << fixed(ms, 2)
+            << " ms, wrote " << written << "\n";
+  if (errors) std::cout << "error vs ground truth: " << errors_line(*errors) << "\n";
+}
+
+}  // namespace
+
+void add_flow_command(CLI::App& app, int& /*exit_code*/) {
+  static FlowCommand cmd;
+  CLI::App* sub = app.add_subcommand(
+      "flow", "Dense flow of one image pair (or a built-in synthetic pair) to a .flo file");
+  sub->add_option("A", cmd.frame0, "frame t (read as 8-bit gray)")->type_name("IMAGE");
+  sub->add_option("B", cmd.frame1, "frame t+1")->type_name("IMAGE");
+  std::vector<std::string> scenes;
+  for (eval::SceneKind kind : eval::synthetic_scene_kinds())
+    scenes.emplace_back(eval::to_string(kind));
+  sub->add_option("--synthetic", cmd.scene,
+                  "use a built-in " + size_text(kSyntheticSize) +
+                      " pair with exact ground truth instead of A B, and print the error")
+      ->type_name("SCENE")
+      ->expected(0, 1)
+      ->default_str(eval::to_string(eval::SceneKind::MovingObject))
+      ->check(CLI::IsMember(scenes));
+  sub->add_option("-o,--output", cmd.output, "the flow, Middlebury .flo")
+      ->type_name("FLO")
+      ->required();
+  sub->add_option("--color", cmd.color, "the flow in Middlebury colour coding")->type_name("IMAGE");
+  sub->add_option("--legend", cmd.legend, "the colour wheel, as a legend")->type_name("IMAGE");
+  sub->add_option("--gt", cmd.ground_truth, "ground-truth flow: print the error against it")
+      ->type_name("FLO");
+  add_lk_options(*sub, cmd.lk);
+  sub->callback([] { run_flow(cmd); });
+}
+
+}  // namespace roiflow::cli

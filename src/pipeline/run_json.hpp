@@ -1,0 +1,24 @@
+// The run summaries as JSON documents (what `roiflow track --summary` and `roiflow dense
+// --summary` write): every field of the typed summary, in a fixed order, with the per-stage
+// times as report::stages_json gives them.
+//
+//   roiflow::pipeline::TrackSummary s = roiflow::pipeline::run_track_video(source, options);
+//   nlohmann::ordered_json doc = roiflow::pipeline::to_json(s);
+//   doc["input"] = s.input;  // callers add what their document needs beyond the run's figures
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "pipeline/run.hpp"
+
+namespace roiflow::pipeline {
+
+// mode, frames, global_activations, lost_frames, fps, tracker_fps, tracker_ms_per_frame, wall_s,
+// threads, roi, max_in_flight, peak_rss_mb, stages.
+nlohmann::ordered_json to_json(const TrackSummary& s);
+// mode ("dense"), input, frames, pairs, fps, flow_ms_per_pair, wall_s, threads, preset, status,
+// peak_rss_mb, stages.
+nlohmann::ordered_json to_json(const DenseSummary& s, const std::string& preset);
+
+}  // namespace roiflow::pipeline
