@@ -5,8 +5,7 @@
 #include "cli_common.hpp"
 #include "core/atomic_write.hpp"
 #include "eval/flow_input.hpp"
-#include "pipeline/tbb_executor.hpp"
-#include "report/html_report.hpp"
+#include "pipeline/eval_runs.hpp"
 
 namespace roiflow::cli {
 namespace {
@@ -17,41 +16,21 @@ struct EvalCommand {
   std::vector<std::vector<std::string>> pairs;  // A, B, ground truth
   std::vector<std::string> exclude_masks;
   std::string layout = "auto";
-  std::string pass = "auto";
-  std::string scene;
-  int max_pairs = 0;
+  eval::FindOptions find;  // --pass, --scene, --max-pairs
   std::string format = "table";
   std::string output;
   std::string report;
 };
-
-// `skipped` receives what a partial tree lacks (see eval::find_pairs).
-std::vector<eval::EvalPair> eval_pairs(const EvalCommand& cmd, std::vector<std::string>& skipped) {
-  if (cmd.dir.empty() && cmd.pairs.empty()) {
-    throw UsageError(
-        "eval needs a Middlebury, Sintel or KITTI directory DIR or at least one --pair A B GT");
-  }
-  if (!cmd.dir.empty()) {
-    eval::FindOptions options;
-    options.layout = eval::parse_layout(cmd.layout);
-    options.pass = cmd.pass;
-    options.scene = cmd.scene;
-    options.max_pairs = cmd.max_pairs;
-    return eval::find_pairs(cmd.dir, options, &skipped);
-  }
-  try {
-    return eval::listed_pairs(cmd.pairs, cmd.exclude_masks);
-  } catch (const Error& e) {
-    throw UsageError(e.what());
-  }
-}
 
 void run_eval(const EvalCommand& cmd) {
   const flow::LkParams params = lk_params(cmd.lk);
   if (!cmd.output.empty()) check_output_path(cmd.output, "-o");
   if (!cmd.report.empty()) check_output_path(cmd.report, "--report");
   std::vector<std::string> skipped;
-  const std::vector<eval::EvalPair> pairs = eval_pairs(cmd, skipped);
+  eval::FindOptions find = cmd.find;
+  find.layout = eval::parse_layout(cmd.layout);
+  const std::vector<eval::EvalPair> pairs =
+      eval::select_pairs(cmd.dir, find, cmd.pairs, cmd.exclude_masks, &skipped);
   // Partial downloads are evaluated as they are, and the gaps said once, on stderr so that
   // CSV and JSON on stdout stay machine-readable.
   if (!skipped.empty()) std::cerr << "roiflow: " << eval::skipped_line(skipped) << "\n";
@@ -61,24 +40,12 @@ void run_eval(const EvalCommand& cmd) {
     report.emplace("roiflow eval " + (cmd.dir.empty() ? std::string("--pair") : cmd.dir),
                    cmd.lk.preset, params);
   }
-  const pipeline::TbbExecutor executor;
-  std::vector<eval::EvalRow> rows;
-  pipeline::run_with_threads(cmd.lk.threads, [&] {
-    for (const eval::EvalPair& pair : pairs) {
-      eval::EvalImages images;
-      rows.push_back(eval::evaluate_pair(pair, params, &executor, report ? &images : nullptr));
-      if (report) report->add(rows.back(), images);
-    }
-  });
+  const std::vector<eval::EvalRow> rows =
+      pipeline::run_eval(pairs, params, cmd.lk.threads, report ? &*report : nullptr);
 
-  std::string text;
-  if (cmd.format == "csv") {
-    text = eval::format_csv(rows);
-  } else if (cmd.format == "json") {
-    text = eval::format_json(rows, cmd.lk.preset, params);
-  } else {
-    text = eval::format_table(rows);
-  }
+  const std::string text = cmd.format == "csv"    ? eval::format_csv(rows)
+                           : cmd.format == "json" ? eval::format_json(rows, cmd.lk.preset, params)
+                                                  : eval::format_table(rows);
   if (report) report->write(cmd.report);
   if (cmd.output.empty()) {
     std::cout << text;
@@ -119,18 +86,18 @@ void add_eval_command(CLI::App& app, int& /*exit_code*/) {
       ->check(CLI::IsMember({"auto", "middlebury", "sintel", "kitti"}))
       ->capture_default_str()
       ->needs(dir);
-  sub->add_option("--pass", cmd.pass,
+  sub->add_option("--pass", cmd.find.pass,
                   "Sintel rendering pass (auto: per scene, the first of clean, final, albedo "
                   "that the tree has; the pass shows in each row's name)")
       ->type_name("PASS")
       ->check(CLI::IsMember({"auto", "clean", "final", "albedo"}))
       ->capture_default_str()
       ->needs(dir);
-  sub->add_option("--scene", cmd.scene,
+  sub->add_option("--scene", cmd.find.scene,
                   "only this scene of DIR (Sintel alley_1, Middlebury Venus, KITTI 000042)")
       ->type_name("NAME")
       ->needs(dir);
-  sub->add_option("--max-pairs", cmd.max_pairs,
+  sub->add_option("--max-pairs", cmd.find.max_pairs,
                   "at most N pairs of DIR, evenly spaced over the sorted list (0: all)")
       ->type_name("N")
       ->check(CLI::NonNegativeNumber)

@@ -1,14 +1,12 @@
 // roiflow flow: dense flow of one image pair (or a synthetic one) to a .flo file.
-#include <chrono>
 #include <iostream>
-#include <optional>
 
 #include "cli_common.hpp"
 #include "eval/flo_io.hpp"
 #include "eval/flow_input.hpp"
 #include "eval/image_io.hpp"
 #include "flow/color_code.hpp"
-#include "pipeline/tbb_executor.hpp"
+#include "pipeline/eval_runs.hpp"
 
 namespace roiflow::cli {
 namespace {
@@ -39,40 +37,28 @@ void run_flow(const FlowCommand& cmd) {
     throw UsageError("flow needs two images A B, or --synthetic [scene]");
   }
   check_output_path(cmd.output, "-o");
-  if (!cmd.color.empty()) check_image_output(cmd.color, "--color");
-  if (!cmd.legend.empty()) check_image_output(cmd.legend, "--legend");
+  if (!cmd.color.empty()) eval::check_image_output(cmd.color, "--color");
+  if (!cmd.legend.empty()) eval::check_image_output(cmd.legend, "--legend");
   const eval::FlowInput in = synthetic
                                  ? eval::synthetic_flow_input(cmd.scene, kSyntheticSize)
                                  : eval::read_flow_input(cmd.frame0, cmd.frame1, cmd.ground_truth);
 
-  const pipeline::TbbExecutor executor;
-  flow::FlowOptions options;
-  const auto start = std::chrono::steady_clock::now();
-  const flow::FlowResult result = pipeline::run_with_threads(cmd.lk.threads, [&] {
-    return flow::dense_flow(in.frame0, in.frame1, params, options, &executor);
-  });
-  const double ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const pipeline::FlowRun r = pipeline::run_flow(in, params, cmd.lk.threads);
   // Scored before writing so that a failure here leaves no output behind.
-  std::optional<flow::FlowErrors> errors;
-  if (!in.truth.empty()) {
-    errors = flow::flow_errors(result.flow, in.truth);
-    if (errors->pixels == 0) throw Error("--gt: '" + cmd.ground_truth + "' is unknown everywhere");
+  if (r.errors && r.errors->pixels == 0) {
+    throw Error("--gt: '" + cmd.ground_truth + "' is unknown everywhere");
   }
-
-  std::string written = cmd.output;
-  eval::write_flo(cmd.output, result.flow);
+  std::vector<std::string> written{cmd.output};
+  eval::write_flo(cmd.output, r.flow);
   if (!cmd.color.empty()) {
-    eval::write_image_atomically(cmd.color, flow::flow_to_color(result.flow));
-    written += ", " + cmd.color;
+    eval::write_image_atomically(written.emplace_back(cmd.color), flow::flow_to_color(r.flow));
   }
   if (!cmd.legend.empty()) {
-    eval::write_image_atomically(cmd.legend, flow::color_wheel_legend());
-    written += ", " + cmd.legend;
+    eval::write_image_atomically(written.emplace_back(cmd.legend), flow::color_wheel_legend());
   }
-  std::cout << "flow " << size_text(in.frame0.size()) << " (" << in.source << "): " << fixed(ms, 2)
-            << " ms, wrote " << written << "\n";
-  if (errors) std::cout << "error vs ground truth: " << errors_line(*errors) << "\n";
+  std::cout << "flow " << size_text(in.frame0.size()) << " (" << in.source
+            << "): " << fixed(r.ms, 2) << " ms, wrote " << joined(written) << "\n";
+  if (r.errors) std::cout << "error vs ground truth: " << eval::errors_text(*r.errors) << "\n";
 }
 
 }  // namespace

@@ -1,18 +1,10 @@
-// roiflow — the command-line tool, one git-style subcommand per job.
-//
-//   roiflow flow --synthetic -o out.flo --color out.png
-//   roiflow flow A.png B.png -o out.flo --gt truth.flo
-//   roiflow eval data/middlebury --format csv -o errors.csv
-//   roiflow eval data/sintel/training --pass final --max-pairs 50 --report sintel.html
-//   roiflow score track.csv Car4/groundtruth_rect.txt --format json
-//
-// Each subcommand is a thin layer in apps/<name>_command.cpp: CLI11 parses, the library
-// computes, the command prints.
-// Failures print one line, `roiflow: error: <message>`, on stderr: exit code 2 for a bad
-// command line (including out-of-range LK parameters), 1 for anything that fails at run time.
-// Inputs and output locations are checked before any computation, and every output is written
-// atomically, so a failed run leaves no file behind.
+// roiflow, the command-line tool: one git-style subcommand per job, each in
+// apps/<name>_command.cpp (CLI11 parses, the library computes, the command prints). Failures
+// print one line, `roiflow: error: <message>`, on stderr: exit code 2 for a bad command line
+// (UsageError included), 1 for anything that fails at run time. Inputs and output locations are
+// checked before any computation and outputs are written atomically: a failed run leaves none.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdlib>
 #include <iostream>
 #include <opencv2/core/utils/logger.hpp>
@@ -27,12 +19,9 @@ using namespace roiflow::cli;
 
 // OpenCV's messages span lines; the CLI promises one.
 std::string one_line(std::string text) {
-  for (char& c : text) {
-    if (c == '\n' || c == '\r') c = ' ';
-  }
-  while (!text.empty() && text.back() == ' ')
-    text.pop_back();
-  return text;
+  std::replace_if(
+      text.begin(), text.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
+  return text.erase(text.find_last_not_of(' ') + 1);
 }
 
 int report_error(const std::string& message, int exit_code) {

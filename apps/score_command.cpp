@@ -4,7 +4,6 @@
 
 #include "cli_common.hpp"
 #include "eval/otb_score.hpp"
-#include "eval/track_log.hpp"
 
 namespace roiflow::cli {
 namespace {
@@ -16,31 +15,20 @@ struct ScoreCommand {
 };
 
 void run_score(const ScoreCommand& cmd) {
-  const std::vector<eval::TrackRecord> records = eval::read_track_csv(cmd.track);
-  std::vector<cv::Rect2f> track;
-  try {
-    track = eval::track_boxes(records);
-  } catch (const Error& e) {
-    // track_boxes knows records, not the file they came from.
-    throw Error("track log '" + cmd.track + "': " + e.what());
-  }
+  const std::vector<cv::Rect2f> track = eval::read_track_boxes(cmd.track);
   const std::vector<cv::Rect2f> truth = eval::read_ground_truth(cmd.ground_truth);
   const eval::OtbScore s = eval::score(track, truth);
 
   if (cmd.format == "json") {
-    const nlohmann::ordered_json doc = {{"auc", s.auc},
-                                        {"precision20", s.precision20},
-                                        {"mean_iou", s.mean_iou},
-                                        {"frames", s.frames}};
-    std::cout << doc.dump(2) << "\n";
-    return;
+    std::cout << nlohmann::ordered_json({{"auc", s.auc},
+                                         {"precision20", s.precision20},
+                                         {"mean_iou", s.mean_iou},
+                                         {"frames", s.frames}})
+                     .dump(2)
+              << "\n";
+  } else {
+    std::cout << eval::score_table(s, track.size(), truth.size());
   }
-  // The lengths are shown because a shorter track (--max-frames) scores only its prefix.
-  std::cout << "success AUC    " << fixed(s.auc, 4) << "\n"
-            << "precision@20   " << fixed(s.precision20, 4) << "\n"
-            << "mean IoU       " << fixed(s.mean_iou, 4) << "\n"
-            << "frames         " << s.frames << " (track " << track.size() << ", ground truth "
-            << truth.size() << ")\n";
 }
 
 }  // namespace

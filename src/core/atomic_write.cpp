@@ -50,4 +50,13 @@ void write_text_atomically(const std::string& path, const std::string& text) {
   });
 }
 
+void check_output_path(const std::string& path, const std::string& option) {
+  const fs::path parent = fs::path(path).parent_path();
+  std::error_code ec;
+  if (!parent.empty() && !fs::is_directory(parent, ec)) {
+    throw Error(option + ": directory '" + parent.string() + "' of '" + path + "' does not exist");
+  }
+  if (fs::is_directory(path, ec)) throw Error(option + ": '" + path + "' is a directory");
+}
+
 }  // namespace roiflow

@@ -32,4 +32,8 @@ void write_atomically(const std::string& path, const std::string& what,
 
 void write_text_atomically(const std::string& path, const std::string& text);
 
+// Catches a mistyped output path before minutes of computation are spent: throws roiflow::Error
+// "<option>: directory 'd' of 'd/f' does not exist" or "<option>: 'p' is a directory".
+void check_output_path(const std::string& path, const std::string& option);
+
 }  // namespace roiflow

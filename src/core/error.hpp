@@ -16,4 +16,11 @@ class Error : public std::runtime_error {
   explicit Error(const std::string& what) : std::runtime_error(what) {}
 };
 
+// A request that makes no sense before any input is read (conflicting options, a parameter out
+// of range, a box outside the frame): the CLI reports it like a command-line error (exit code 2).
+class UsageError : public Error {
+ public:
+  using Error::Error;
+};
+
 }  // namespace roiflow

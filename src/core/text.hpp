@@ -13,6 +13,7 @@
 #include <sstream>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace roiflow {
 
@@ -24,6 +25,14 @@ inline std::string fixed(double value, int decimals) {
 // "640x480".
 inline std::string size_text(cv::Size size) {
   return fmt::format("{}x{}", size.width, size.height);
+}
+
+// "a, b, c".
+inline std::string joined(const std::vector<std::string>& items) {
+  std::string list;
+  for (const std::string& item : items)
+    list += (list.empty() ? "" : ", ") + item;
+  return list;
 }
 
 // A number as error messages show it: the shortest stream form ("0.5", "1e-06", "nan"), so that

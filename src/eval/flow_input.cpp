@@ -50,11 +50,42 @@ FlowInput synthetic_flow_input(const std::string& name, cv::Size size) {
   throw Error("unknown synthetic scene '" + name + "'");
 }
 
+std::string errors_text(const flow::FlowErrors& e) {
+  return "AAE " + fixed(e.aae_deg, 3) + " deg, EPE " + fixed(e.epe, 4) + " px, R1 " +
+         fixed(e.r1, 2) + " %, R3 " + fixed(e.r3, 2) + " %";
+}
+
+std::vector<EvalPair> select_pairs(const std::string& dir, const FindOptions& find,
+                                   const std::vector<std::vector<std::string>>& triples,
+                                   const std::vector<std::string>& exclude_masks,
+                                   std::vector<std::string>* skipped) {
+  if (dir.empty() && triples.empty()) {
+    throw UsageError(
+        "eval needs a Middlebury, Sintel or KITTI directory DIR or at least one --pair A B GT");
+  }
+  if (!dir.empty()) return find_pairs(dir, find, skipped);
+  return listed_pairs(triples, exclude_masks);
+}
+
+std::vector<EvalPair> middlebury_or_listed(const std::string& dir,
+                                           const std::vector<std::vector<std::string>>& triples,
+                                           int max_pairs) {
+  if (dir.empty() && triples.empty()) {
+    throw UsageError("sweep needs a Middlebury directory DIR or at least one --pair A B GT");
+  }
+  std::vector<EvalPair> pairs = dir.empty() ? listed_pairs(triples) : find_middlebury(dir);
+  if (max_pairs > 0 && pairs.size() > static_cast<std::size_t>(max_pairs)) {
+    pairs.resize(static_cast<std::size_t>(max_pairs));
+  }
+  return pairs;
+}
+
 std::vector<EvalPair> listed_pairs(const std::vector<std::vector<std::string>>& triples,
                                    const std::vector<std::string>& exclude_masks) {
   if (!exclude_masks.empty() && exclude_masks.size() != triples.size()) {
-    throw Error("--exclude-mask: got " + std::to_string(exclude_masks.size()) + " masks for " +
-                std::to_string(triples.size()) + " pairs (give one per --pair, in the same order)");
+    throw UsageError("--exclude-mask: got " + std::to_string(exclude_masks.size()) + " masks for " +
+                     std::to_string(triples.size()) +
+                     " pairs (give one per --pair, in the same order)");
   }
   std::vector<EvalPair> pairs;
   for (std::size_t i = 0; i < triples.size(); ++i) {

@@ -14,6 +14,7 @@
 
 #include "eval/flow_eval.hpp"
 #include "eval/synthetic.hpp"
+#include "flow/metrics.hpp"
 
 namespace roiflow::eval {
 
@@ -31,7 +32,24 @@ FlowInput read_flow_input(const std::string& frame0, const std::string& frame1,
 FlowInput synthetic_flow_input(const std::string& name, cv::Size size);
 std::vector<SceneKind> synthetic_scene_kinds();
 
-// Pairs "pair1", "pair2", ... from {A, B, GT} triples, with one exclude mask per pair or none.
+// "AAE 1.234 deg, EPE 0.1234 px, R1 1.23 %, R3 0.12 %".
+std::string errors_text(const flow::FlowErrors& e);
+
+// The pairs of `dir` (find_pairs with `find`; `skipped` gets what a partial tree lacks), else
+// listed_pairs of `triples` and `exclude_masks`; UsageError when both are empty.
+std::vector<EvalPair> select_pairs(const std::string& dir, const FindOptions& find,
+                                   const std::vector<std::vector<std::string>>& triples,
+                                   const std::vector<std::string>& exclude_masks,
+                                   std::vector<std::string>* skipped);
+
+// The first `max_pairs` (0: all) pairs of a Middlebury `dir`, else of `triples`; UsageError
+// when both are empty (`roiflow sweep`).
+std::vector<EvalPair> middlebury_or_listed(const std::string& dir,
+                                           const std::vector<std::vector<std::string>>& triples,
+                                           int max_pairs);
+
+// Pairs "pair1", "pair2", ... from {A, B, GT} triples, with one exclude mask per pair or none
+// (else UsageError).
 std::vector<EvalPair> listed_pairs(const std::vector<std::vector<std::string>>& triples,
                                    const std::vector<std::string>& exclude_masks = {});
 

@@ -33,5 +33,7 @@ cv::Mat read_image(const std::string& path, int flags);
 // cv::imwrite to a partial file, then renamed over `path` (core/atomic_write.hpp); the format
 // follows the extension. Throws roiflow::Error "cannot write image '<path>'" on failure.
 void write_image_atomically(const std::string& path, const cv::Mat& image);
+// check_output_path, and UsageError when OpenCV cannot write an image named `path`.
+void check_image_output(const std::string& path, const std::string& option);
 
 }  // namespace roiflow::eval

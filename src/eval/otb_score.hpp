@@ -54,13 +54,23 @@ std::vector<cv::Rect2f> read_ground_truth(const std::string& path);
 // The same from a file's text held in memory; `name` stands for the path in error messages.
 std::vector<cv::Rect2f> parse_ground_truth(std::string_view text, const std::string& name);
 
+// A box typed by a user, "x,y,w,h" (commas and/or spaces), with a finite positive size. Throws
+// roiflow::Error ("expected x,y,w,h, got '1,2,3'") otherwise.
+cv::Rect2f parse_box(const std::string& text);
+
 // The boxes of a track log, box i being frame i + 1. Throws roiflow::Error naming the record
 // when frames are not numbered 1, 2, 3, ... in order (the pairing with ground truth would be
 // wrong).
 std::vector<cv::Rect2f> track_boxes(const std::vector<TrackRecord>& records);
+// track_boxes of the track-log CSV at `path` (read_track_csv); errors name the file.
+std::vector<cv::Rect2f> read_track_boxes(const std::string& path);
 
 // Throws roiflow::Error, naming both lengths, when no frame is left to score.
 OtbScore score(const std::vector<cv::Rect2f>& track, const std::vector<cv::Rect2f>& truth);
+
+// What `roiflow score` prints: AUC, precision@20 and mean IoU to 4 decimals, and the frames
+// scored with both lengths (a shorter track, --max-frames, scores only its prefix).
+std::string score_table(const OtbScore& s, std::size_t track_boxes, std::size_t truth_boxes);
 
 // 0 when either box is empty (zero or negative size) or not finite.
 double iou(const cv::Rect2f& a, const cv::Rect2f& b);

@@ -164,6 +164,30 @@ std::string sweep_csv(const std::vector<SweepRow>& rows) {
   return out;
 }
 
+std::vector<std::pair<SweepParam, std::vector<double>>> sweep_plan(
+    const std::string& name, const std::vector<double>& values, const flow::LkParams& base) {
+  if (name == "all" && !values.empty()) throw UsageError("--values needs one --param, not all");
+  std::vector<std::pair<SweepParam, std::vector<double>>> plan;
+  for (SweepParam p : name == "all" ? all_sweep_params()
+                                    : std::vector<SweepParam>{sweep_param_from_string(name)}) {
+    plan.emplace_back(p, values.empty() ? default_sweep_values(p, base) : values);
+    for (double v : plan.back().second) {
+      try {
+        with_value(base, p, v);
+      } catch (const Error& e) {
+        throw UsageError(std::string("--values: ") + e.what());
+      }
+    }
+  }
+  return plan;
+}
+
+std::string sweep_progress_line(const SweepRow& r, std::size_t index, std::size_t count) {
+  return fmt::format("sweep {} {} ({}/{}): AAE {:.3f} deg, EPE {:.4f} px, {:.2f} ms/pair",
+                     to_string(r.param), sweep_value_text(r.value), index + 1, count, r.aae_deg,
+                     r.epe, r.ms_per_pair);
+}
+
 std::string sweep_table(const std::vector<SweepRow>& rows) {
   std::string out = "parameter    value      AAE(deg)    EPE(px)  ms/pair\n";
   for (const SweepRow& r : rows) {

@@ -15,6 +15,7 @@
 #include <functional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "core/executor.hpp"
@@ -33,6 +34,12 @@ std::vector<SweepParam> all_sweep_params();  // in the order above
 // patch 3..31 (every size), iterations 1..10, levels 1..6; sigma 0..3 px and lambda
 // 1e-8..1e-2 (decades), each with the base value added when it is not in the list.
 std::vector<double> default_sweep_values(SweepParam param, const flow::LkParams& base);
+
+// The parameters `name` stands for ("all": every one) and each one's values: `values`, or its
+// default_sweep_values when empty, each checked with with_value. Throws UsageError ("--values:
+// ...") for a value a parameter cannot take, and for values given with "all".
+std::vector<std::pair<SweepParam, std::vector<double>>> sweep_plan(
+    const std::string& name, const std::vector<double>& values, const flow::LkParams& base);
 
 // `base` with `param` set to `value`; throws roiflow::Error ("patch 40: patch must be in
 // 3..31, got 40") when the result is invalid or an integer parameter gets a fraction.
@@ -65,6 +72,8 @@ std::vector<SweepRow> sweep(const std::vector<EvalPair>& pairs, const flow::LkPa
 std::string sweep_value_text(double value);
 // Header `parameter,value,aae_deg,epe,ms_per_pair`; aae 3 decimals, epe 4, ms 2.
 std::string sweep_csv(const std::vector<SweepRow>& rows);
+// "sweep patch 7 (3/29): AAE 4.123 deg, EPE 0.4123 px, 12.34 ms/pair" for value i of n.
+std::string sweep_progress_line(const SweepRow& row, std::size_t index, std::size_t count);
 // The table `roiflow sweep` prints: parameter, value, AAE, EPE, ms per pair.
 std::string sweep_table(const std::vector<SweepRow>& rows);
 

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -152,6 +153,14 @@ double speedup(const CompareRun& local, const CompareRun& global) {
 }
 
 CompareResult run_compare(const CompareOptions& o) {
+  if (std::all_of(o.input.begin(), o.input.end(),
+                  [](unsigned char c) { return std::isdigit(c); })) {
+    throw UsageError("--compare needs a video file or an image folder: a camera (" + o.input +
+                     ") would show each mode different frames");
+  }
+  // Opened here only to check the input and the init box before any run starts.
+  check_init_inside(o.run.tracker.init,
+                    stages::VideoSource(o.input, source_params(o.source)).size(), 0.f);
   std::error_code ec;
   if (fs::exists(o.out_dir, ec) && !fs::is_directory(o.out_dir, ec)) {
     throw Error("--compare-out: '" + o.out_dir + "' exists and is not a directory");

@@ -45,8 +45,9 @@ struct CompareResult {
   bool cancelled = false;                                  // the runs were cut short
 };
 
-// Runs every mode and patch size. Throws roiflow::Error naming the run when its input stops
-// mid-stream, and for an out_dir that is not a directory.
+// Runs every mode and patch size. Throws UsageError for a camera input or an init box outside
+// the frame (before any run), roiflow::Error naming the run when its input stops mid-stream, and
+// for an out_dir that is not a directory.
 CompareResult run_compare(const CompareOptions& options);
 // ms per frame (median) of global over local: how many times faster local mode is.
 double speedup(const CompareRun& local, const CompareRun& global);

@@ -6,7 +6,7 @@
 //   roiflow::pipeline::DemoOptions options;
 //   options.dir = "out/demo";
 //   const roiflow::pipeline::DemoResult r = roiflow::pipeline::run_demo(options);
-//   std::cout << "success AUC " << r.score.auc << "\n";
+//   std::cout << roiflow::pipeline::demo_text(r);  // or r.score.auc, r.local.tracker_fps, ...
 #pragma once
 
 #include <atomic>
@@ -37,5 +37,7 @@ struct DemoResult {
 };
 
 DemoResult run_demo(const DemoOptions& options);
+// What `roiflow demo` prints: the scene, the local run, its error, the speed-up, the files.
+std::string demo_text(const DemoResult& r);
 
 }  // namespace roiflow::pipeline

@@ -1,9 +1,13 @@
 #include "pipeline/run.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <iostream>
 #include <optional>
 
+#include "core/error.hpp"
+#include "core/text.hpp"
 #include "flow/color_code.hpp"
 #include "pipeline/tbb_executor.hpp"
 #include "report/annotate.hpp"
@@ -119,7 +123,20 @@ TrackSummary run_track_stream(const FrameSource& frames, const StreamInfo& info,
   return s;
 }
 
+void check_init_inside(const std::optional<cv::Rect2f>& init, cv::Size size, float min_side) {
+  if (!init) return;
+  const cv::Rect2f inside =
+      *init & cv::Rect2f(0.f, 0.f, static_cast<float>(size.width), static_cast<float>(size.height));
+  if (inside.width < min_side || inside.height < min_side || inside.area() <= 0.f) {
+    throw UsageError(
+        fmt::format("--init: the box {},{},{},{} lies outside the {} frame{}", number_text(init->x),
+                    number_text(init->y), number_text(init->width), number_text(init->height),
+                    size_text(size), min_side > 0 ? " (less than 2x2 pixels of it inside)" : ""));
+  }
+}
+
 TrackSummary run_track_video(stages::VideoSource& source, const TrackRunOptions& options) {
+  check_init_inside(options.tracker.init, source.size(), 2.f);
   const StreamInfo info{source.size(), source.fps(), source.frame_count_hint(),
                         source.description()};
   TrackSummary s = run_track_stream([&] { return source.next(); }, info, options);

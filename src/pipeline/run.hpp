@@ -16,6 +16,7 @@
 
 #include <atomic>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -82,9 +83,14 @@ struct TrackSummary {
   std::vector<eval::TrackRecord> records;  // with keep_records
 };
 
+// Throws UsageError, before the first frame is tracked, when less than 2x2 pixels of
+// options.tracker.init lie inside the frame.
 TrackSummary run_track_video(stages::VideoSource& source, const TrackRunOptions& options);
 TrackSummary run_track_stream(const FrameSource& frames, const StreamInfo& info,
                               const TrackRunOptions& options);
+// Throws UsageError when less than `min_side` x `min_side` pixels of `init` (any part of it when
+// min_side is 0) lie inside a frame of `size`.
+void check_init_inside(const std::optional<cv::Rect2f>& init, cv::Size size, float min_side);
 
 struct DenseRunOptions {
   flow::LkParams lk = flow::LkParams::paper();

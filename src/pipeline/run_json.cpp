@@ -1,5 +1,7 @@
 #include "pipeline/run_json.hpp"
 
+#include <fmt/format.h>
+
 namespace roiflow::pipeline {
 
 nlohmann::ordered_json to_json(const TrackSummary& s) {
@@ -31,6 +33,14 @@ nlohmann::ordered_json to_json(const DenseSummary& s, const std::string& preset)
           {"status", s.status},
           {"peak_rss_mb", s.peak_rss_mb},
           {"stages", report::stages_json(s.stages)}};
+}
+
+std::string summary_text(const std::string& what, const TrackSummary& s) {
+  return fmt::format(
+      "{}: {} frames in {:.2f} s, {:.1f} fps overall, tracker {:.1f} fps ({:.3f} ms/frame, decode "
+      "excluded), mode {}\n  global activations {}, frames lost {}, {} threads\n",
+      what, s.frames, s.wall_s, s.fps, s.tracker_fps, s.tracker_ms_per_frame, s.mode,
+      s.global_activations, s.lost_frames, s.threads);
 }
 
 }  // namespace roiflow::pipeline

@@ -22,6 +22,7 @@
 namespace roiflow::pipeline {
 
 inline constexpr int kMaxThreads = 256;
+int default_threads();  // the hardware's thread count, within 1..kMaxThreads
 
 class TbbExecutor final : public Executor {
  public:

@@ -43,4 +43,8 @@ class TrackLogWriter {
   std::streampos array_end_;  // JSON: where the closing bracket starts, overwritten next
 };
 
+// Before a run: check_output_path(path, option), and UsageError "<option>: 'p' must end in .csv
+// or .json" for a name TrackLogWriter would refuse.
+void check_track_log_path(const std::string& path, const std::string& option);
+
 }  // namespace roiflow::stages

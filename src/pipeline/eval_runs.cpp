@@ -1,5 +1,6 @@
-#include "pipeline/sweep_run.hpp"
+#include "pipeline/eval_runs.hpp"
 
+#include <chrono>
 #include <filesystem>
 
 #include "core/atomic_write.hpp"
@@ -27,6 +28,34 @@ void prepare_out_dir(const std::string& dir) {
 
 }  // namespace
 
+FlowRun run_flow(const eval::FlowInput& in, const flow::LkParams& params, int threads) {
+  const TbbExecutor executor;
+  FlowRun r;
+  const auto start = std::chrono::steady_clock::now();
+  r.flow = run_with_threads(threads, [&] {
+    return flow::dense_flow(in.frame0, in.frame1, params, flow::FlowOptions{}, &executor).flow;
+  });
+  r.ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  if (!in.truth.empty()) r.errors = flow::flow_errors(r.flow, in.truth);
+  return r;
+}
+
+std::vector<eval::EvalRow> run_eval(const std::vector<eval::EvalPair>& pairs,
+                                    const flow::LkParams& params, int threads,
+                                    report::HtmlReport* report) {
+  const TbbExecutor executor;
+  std::vector<eval::EvalRow> rows;
+  run_with_threads(threads, [&] {
+    for (const eval::EvalPair& pair : pairs) {
+      eval::EvalImages images;
+      rows.push_back(eval::evaluate_pair(pair, params, &executor, report ? &images : nullptr));
+      if (report) report->add(rows.back(), images);
+    }
+  });
+  return rows;
+}
+
 SweepRunResult run_sweep(const SweepRunOptions& o) {
   prepare_out_dir(o.out_dir);
   const std::string csv_path = (fs::path(o.out_dir) / "sweep.csv").string();
@@ -34,14 +63,13 @@ SweepRunResult run_sweep(const SweepRunOptions& o) {
   SweepRunResult r;
   r.written.push_back(csv_path);
   run_with_threads(o.threads, [&] {
-    for (std::size_t k = 0; k < o.params.size(); ++k) {
-      const eval::SweepParam p = o.params[k];
-      const std::size_t n = o.values[k].size();
+    for (const auto& [p, values] : o.plan) {
+      const std::size_t n = values.size();
       const auto progress = [&](const eval::SweepRow& row, std::size_t i) {
         if (o.progress) o.progress(row, i, n);
       };
       const std::vector<eval::SweepRow> part =
-          eval::sweep(o.pairs, o.base, p, o.values[k], &executor, progress, o.repeats);
+          eval::sweep(o.pairs, o.base, p, values, &executor, progress, o.repeats);
       r.rows.insert(r.rows.end(), part.begin(), part.end());
       write_text_atomically(csv_path, eval::sweep_csv(r.rows));
       const std::string svg =
