@@ -1,34 +1,12 @@
 #include "cli_common.hpp"
 
-#include <functional>
 #include <limits>
 #include <opencv2/imgcodecs.hpp>
-#include <type_traits>
 
-#include "flow/large_motion.hpp"
-#include "flow/pyramid.hpp"
+#include "flow/lk_options.hpp"
 #include "pipeline/tbb_executor.hpp"
 
 namespace roiflow::cli {
-namespace {
-
-// The value an override takes: a member of LkParams, or a setter void(LkParams&, T).
-template <class F>
-struct ValueOf : ValueOf<decltype(std::function(std::declval<F>()))> {};
-template <class T>
-struct ValueOf<std::function<void(flow::LkParams&, T)>> {
-  using type = T;
-};
-template <class T>
-struct ValueOf<T flow::LkParams::*> {
-  using type = T;
-};
-
-}  // namespace
-
-// ---------------------------------------------------------------------------------------------
-// Shared Lucas-Kanade options
-
 void add_lk_options(CLI::App& cmd, LkOptions& lk) {
   const std::string group = "Lucas-Kanade parameters (default: the preset's)";
   cmd.add_option("--preset", lk.preset, "parameter set the options below override")
@@ -37,70 +15,31 @@ void add_lk_options(CLI::App& cmd, LkOptions& lk) {
       ->capture_default_str()
       ->group(group);
   // Each override is kept as the change it makes, applied over the preset by lk_params().
-  using P = flow::LkParams;
-  const auto add = [&](const char* name, const std::string& help, auto set) {
-    using T = typename ValueOf<decltype(set)>::type;
-    const auto keep = [&lk, set](const T& v) {
-      lk.overrides.push_back([set, v](P& p) {
-        if constexpr (std::is_member_object_pointer_v<decltype(set)>) {
-          p.*set = v;
-        } else {
-          set(p, v);
-        }
-      });
+  using T = flow::LkOption::Type;
+  for (const flow::LkOption& o : flow::lk_options()) {
+    const auto keep = [&lk, &o](double v, const std::string& w) {
+      lk.overrides.push_back([&o, v, w](flow::LkParams& p) { o.set(p, v, w); });
     };
-    return cmd.add_option_function<T>(name, keep, help)->group(group);
-  };
-  add("--patch", "window side in pixels", &P::patch)->check(CLI::Range(3, 31));
-  add("--levels", "pyramid levels, or auto (from the frame size and --expected-motion)",
-      [](P& p, std::string v) { p.levels = v == "auto" ? 0 : std::stoi(v); })
-      ->type_name("N|auto")
-      ->check(CLI::Range(1, flow::kMaxLevels) | CLI::IsMember({"auto"}));
-  add("--expected-motion",
-      "largest motion to expect, pixels (0 = a quarter of the larger side): sets --levels auto "
-      "and the coarse search's radius",
-      &P::expected_motion)
-      ->check(CLI::Range(0.0, 1e5));
-  add("--search-radius",
-      "coarse search at the coarsest level: largest radius in its pixels (0 = off)",
-      &P::search_radius)
-      ->check(CLI::Range(0, flow::kMaxSearchRadius));
-  add("--coarsest-side", "--levels auto: the coarsest level's shorter side, pixels",
-      &P::coarsest_side)
-      ->check(CLI::Range(flow::kMinLevelSide, 480));
-  add("--fuse-far-step",
-      "candidate fusion before each level, first pass: neighbours this many pixels away (0 = off)",
-      &P::fuse_far_step)
-      ->check(CLI::Range(0, 32));
-  add("--fuse-far-finest-level", "finest pyramid level the first fusion pass runs on",
-      &P::fuse_far_finest_level)
-      ->check(CLI::Range(0, flow::kMaxLevels - 1));
-  add("--fuse-step", "candidate fusion, second pass: neighbours this many pixels away (0 = off)",
-      &P::fuse_step)
-      ->check(CLI::Range(0, 32));
-  add("--fuse-finest-level", "finest pyramid level the second fusion pass runs on",
-      &P::fuse_finest_level)
-      ->check(CLI::Range(0, flow::kMaxLevels - 1));
-  add("--mask-outside", "samples of frame t+1 outside the frame carry no brightness term (0 or 1)",
-      [](P& p, int v) { p.mask_outside = v != 0; })
-      ->check(CLI::IsMember({0, 1}));
-  add("--finest-level", "pyramid level LK stops at; finer levels get the upsampled flow",
-      &P::finest_level)
-      ->check(CLI::Range(0, flow::kMaxLevels - 1));
-  add("--iterations", "refinement iterations per level", &P::iterations)->check(CLI::Range(1, 50));
-  add("--sigma", "pretreatment Gaussian sigma in pixels, 0..20 (0 = off)", &P::sigma);
-  add("--lambda", "Tikhonov weight, (0, 1]", &P::lambda);
-  add("--derivative", "image derivatives",
-      [](P& p, std::string v) { p.derivative = flow::derivative_from_string(v); })
-      ->type_name("NAME")
-      ->check(CLI::IsMember({"hs", "scharr", "central"}));
-  add("--robust-scale", "Cauchy reweighting scale of the residuals, 0..1 (0 = plain least squares)",
-      &P::robust_scale);
-  add("--level-median", "median filter of the flow after each coarse level (0 = off)",
-      &P::level_median)
-      ->check(CLI::IsMember({0, 3, 5}));
-  add("--final-median", "median filter of the final flow (0 = off)", &P::final_median)
-      ->check(CLI::IsMember({0, 3, 5}));
+    const std::string name = std::string("--") + o.name;
+    CLI::Option* opt =
+        o.type == T::Int ? cmd.add_option_function<int>(name, [keep](int v) { keep(v, ""); })
+        : o.type == T::Real
+            ? cmd.add_option_function<double>(name, [keep](double v) { keep(v, ""); })
+            : cmd.add_option_function<std::string>(name,
+                                                   [keep](const std::string& w) { keep(0, w); });
+    opt->description(o.help)->group(group);
+    if (o.type_name != nullptr) opt->type_name(o.type_name);
+    const bool range = o.min < o.max;
+    const CLI::Range int_range(static_cast<int>(o.min), static_cast<int>(o.max));
+    if (o.type == T::Int && range) opt->check(int_range);
+    if (o.type == T::Real && range) opt->check(CLI::Range(o.min, o.max));
+    if (!o.int_choices.empty()) {
+      opt->check(CLI::IsMember(std::vector<int>(o.int_choices.begin(), o.int_choices.end())));
+    }
+    if (!o.choices.empty()) {
+      opt->check(range ? int_range | CLI::IsMember(o.choices) : CLI::IsMember(o.choices));
+    }
+  }
   cmd.add_option("--threads", lk.threads, "worker threads")
       ->check(CLI::Range(1, pipeline::kMaxThreads))
       ->capture_default_str()

@@ -4,6 +4,7 @@
 
 #include "cli_common.hpp"
 #include "eval/otb_score.hpp"
+#include "eval/score_text.hpp"
 
 namespace roiflow::cli {
 namespace {
@@ -12,9 +13,16 @@ struct ScoreCommand {
   std::string track;
   std::string ground_truth;
   std::string format = "table";
+  bool mot = false;
 };
 
 void run_score(const ScoreCommand& cmd) {
+  if (cmd.mot) {
+    const auto truth = eval::read_mot(cmd.ground_truth, "ground truth");  // read first
+    const eval::MotScore s = eval::score_mot(eval::read_mot(cmd.track, "tracker output"), truth);
+    std::cout << (cmd.format == "json" ? mot_score_json(s).dump(2) + "\n" : mot_score_table(s));
+    return;
+  }
   const std::vector<cv::Rect2f> track = eval::read_track_boxes(cmd.track);
   const std::vector<cv::Rect2f> truth = eval::read_ground_truth(cmd.ground_truth);
   const eval::OtbScore s = eval::score(track, truth);
@@ -48,6 +56,8 @@ void add_score_command(CLI::App& app, int& /*exit_code*/) {
       ->type_name("FORMAT")
       ->check(CLI::IsMember({"table", "json"}))
       ->capture_default_str();
+  sub->add_flag("--mot", cmd.mot,
+                "multi-object: TRACK and GROUNDTRUTH are MOTChallenge files; CLEAR-MOT and IDF1");
   sub->callback([] { run_score(cmd); });
 }
 

@@ -27,11 +27,11 @@ inline std::string size_text(cv::Size size) {
   return fmt::format("{}x{}", size.width, size.height);
 }
 
-// "a, b, c".
-inline std::string joined(const std::vector<std::string>& items) {
+// "a, b, c" (with the default separator).
+inline std::string joined(const std::vector<std::string>& items, std::string_view sep = ", ") {
   std::string list;
   for (const std::string& item : items)
-    list += (list.empty() ? "" : ", ") + item;
+    list += (list.empty() ? "" : std::string(sep)) + item;
   return list;
 }
 
