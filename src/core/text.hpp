@@ -1,9 +1,12 @@
-// Text for the places it is shown: numbers as the user wrote them, values quoted for an error
-// message, and text made safe for HTML or SVG.
+// Text for the places it is shown: numbers with fixed decimals (libfmt), sizes, lists, numbers
+// as the user wrote them, values quoted for an error message, and text made safe for HTML/SVG.
 //
-//   throw Error("roi must be in 8..4096, got " + number_text(roi));
-//   throw Error(path + ":" + std::to_string(line) + ": bad number " + quoted_excerpt(field));
-//   svg += "<text>" + escape_markup(label) + "</text>";
+//   std::string line = "EPE " + roiflow::fixed(0.12345, 3) + " px at " +
+//                      roiflow::size_text({640, 480});          // "EPE 0.123 px at 640x480"
+//   line += " (" + roiflow::joined({"a.csv", "b.svg"}) + ")";   // "(a.csv, b.svg)"
+//   const std::string error = "bad number " + roiflow::quoted_excerpt("12x") + ", roi " +
+//                             roiflow::number_text(0.5);        // "bad number '12x', roi 0.5"
+//   const std::string svg = "<text>" + roiflow::escape_markup("a < b") + "</text>";
 #pragma once
 
 #include <fmt/format.h>

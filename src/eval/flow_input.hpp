@@ -4,8 +4,10 @@
 // --pair lists of `roiflow eval` and `roiflow sweep` as EvalPairs.
 //
 //   const roiflow::eval::FlowInput in = roiflow::eval::read_flow_input("a.png", "b.png", "gt.flo");
-//   cv::Mat flow = roiflow::flow::dense_flow(in.frame0, in.frame1).flow;
-//   if (!in.truth.empty()) std::cout << roiflow::flow::flow_errors(flow, in.truth).epe << "\n";
+//   const roiflow::flow::LkParams params = roiflow::flow::LkParams::paper();
+//   const cv::Mat flow = roiflow::flow::dense_flow(in.frame0, in.frame1, params).flow;
+//   if (in.truth.empty()) return;
+//   std::cout << roiflow::eval::errors_text(roiflow::flow::flow_errors(flow, in.truth)) << "\n";
 #pragma once
 
 #include <opencv2/core.hpp>

@@ -1,32 +1,14 @@
-// OTB one-pass evaluation (OPE) of a track against ground-truth boxes.
+// OTB one-pass evaluation (OPE) of a track against ground-truth boxes, as the OTB benchmark's
+// MATLAB code computes it (success AUC over 21 IoU thresholds, precision@20 px, mean IoU), with
+// the departures docs/SCORING.md lists (absent-target frames left out, the shorter length
+// scored); the ground-truth reader, the track's boxes, the curves of the plots and the text
+// `roiflow score` prints.
 //
-//   using namespace roiflow;
-//   const auto truth = eval::read_ground_truth("Car4/groundtruth_rect.txt");
-//   const auto track = eval::track_boxes(eval::read_track_csv("car4.csv"));
-//   const eval::OtbScore s = eval::score(track, truth);   // s.auc, s.precision20, ...
-//
-// The metrics follow the OTB benchmark's MATLAB code (Wu, Lim, Yang, CVPR 2013 and TPAMI 2015;
-// calcSeqErrRobust.m, calcRectInt.m, perfPlot.m), which pysot and got10k reproduce:
-//  - IoU of the axis-aligned boxes. OTB's inclusive pixel bounds (right = x + w - 1, overlap
-//    width = min(right) - max(left) + 1) give exactly the continuous intersection used here.
-//  - Success AUC: the mean, over the 21 thresholds t = 0, 0.05, ..., 1, of the share of frames
-//    with IoU > t (strictly, as OTB's `errCoverage > thresholdSetOverlap`). No IoU exceeds 1,
-//    so a perfect track scores 20/21 = 0.952, as it does in OTB.
-//  - Precision@20: the share of frames whose centre error is <= 20 px (`errCenter <=`). OTB's
-//    centre x + (w - 1) / 2 and the x + w / 2 used here differ by the same 0.5 px for both
-//    boxes, so the distance is the same.
-//  - Mean IoU over the scored frames.
-// Where this departs from OTB's code, on purpose:
-//  - Ground-truth frames that mark the target absent (NaN, or a width or height that is not
-//    positive, e.g. an all-zero line) are left out of every metric and of `frames`. OTB instead
-//    counts them in the denominator as IoU -1 (a miss at every threshold) and centre error -1 (a
-//    hit at every threshold), and also treats a present target at x = 0 or y = 0 as absent.
-//  - The track's first box is scored as given. OTB overwrites it with the ground truth; a
-//    tracker started with `--init` from that box logs it anyway.
-//  - Frame i is compared with frame i over the shorter of the two lengths: a track cut short
-//    (`--max-frames`) scores its prefix; extra boxes on either side are ignored (OTB drops a
-//    longer result's tail too). `frames` says how many frames were scored; callers that want
-//    the full sequence compare it with the ground truth's length.
+//   const std::vector<cv::Rect2f> truth =
+//       roiflow::eval::parse_ground_truth("10,10,40,30\n12,11,40,30\n", "memory");
+//   const std::vector<cv::Rect2f> track = {{10, 10, 40, 30}, {13, 11, 40, 30}};
+//   const roiflow::eval::OtbScore s = roiflow::eval::score(track, truth);
+//   std::cout << roiflow::eval::score_table(s, track.size(), truth.size());  // AUC, precision...
 #pragma once
 
 #include <opencv2/core.hpp>

@@ -1,15 +1,14 @@
-// Parameter sweeps of dense LK over pairs with ground truth (the paper's Fig. 7 and 8).
+// Parameter sweeps of dense LK over pairs with ground truth (the paper's Fig. 7 and 8): one
+// parameter varies, the others keep the base values; each value is evaluated on every pair
+// (evaluate_pair, dense LK timed alone, the fastest of `repeats` runs) and summarised as mean
+// AAE, mean EPE and mean milliseconds per pair. A value the parameter cannot take throws
+// roiflow::Error naming it.
 //
-//   using namespace roiflow;
-//   const auto pairs = eval::find_middlebury("data/middlebury");
-//   const auto rows = eval::sweep(pairs, flow::LkParams::paper(), eval::SweepParam::Patch,
-//                                   eval::default_sweep_values(eval::SweepParam::Patch, {}));
-//   write_text_atomically("out/sweep.csv", eval::sweep_csv(rows));
-//
-// One parameter varies at a time, the others keep the base parameters' values. Each value is
-// evaluated on every pair with evaluate_pair (dense_flow timed alone, file I/O excluded) and
-// summarised as the mean AAE, mean EPE and mean milliseconds per pair. A value the parameter
-// cannot take (patch 40, iterations 2.5, lambda 0) throws roiflow::Error naming it.
+//   const auto pairs = roiflow::eval::find_middlebury("data/middlebury");
+//   const auto plan = roiflow::eval::sweep_plan("patch", {5, 9, 13}, roiflow::flow::LkParams{});
+//   const auto rows = roiflow::eval::sweep(pairs, roiflow::flow::LkParams::paper(),
+//                                          plan[0].first, plan[0].second);
+//   std::cout << roiflow::eval::sweep_table(rows) << roiflow::eval::sweep_csv(rows);
 #pragma once
 
 #include <functional>

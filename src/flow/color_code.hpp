@@ -1,11 +1,12 @@
-// Middlebury colour coding of flow (Baker et al. 2011; the paper's Fig. 10).
+// Middlebury colour coding of flow (Baker et al. 2011; the paper's Fig. 10): hue gives the
+// direction (the 55-colour Middlebury wheel), saturation the magnitude relative to
+// `max_magnitude` (<= 0: the largest known magnitude in the field); unknown pixels (|u| or |v| >
+// 1e9, NaN) are black. Also the wheel as a legend and arrows drawn over an image.
 //
-//   cv::Mat bgr = roiflow::flow::flow_to_color(flow);        // CV_8UC3, for cv::imwrite
-//   cv::Mat key = roiflow::flow::color_wheel_legend(151);    // the wheel, as a legend
-//
-// Hue gives the direction (the 55-colour Middlebury wheel: RY 15, YG 6, GC 4, CB 11, BM 13,
-// MR 6), saturation the magnitude relative to `max_magnitude` (<= 0: the largest known
-// magnitude in the field). Unknown pixels (|u| or |v| > 1e9, NaN) are black.
+//   const cv::Mat flow(frame_t.size(), CV_32FC2, cv::Scalar(1.5f, -0.5f));
+//   const cv::Mat coded = roiflow::flow::flow_to_color(flow);     // CV_8UC3, for cv::imwrite
+//   const cv::Mat legend = roiflow::flow::color_wheel_legend(151);
+//   const cv::Mat arrows = roiflow::flow::draw_flow_vectors(bgr, flow, 16);
 #pragma once
 
 #include <opencv2/core.hpp>

@@ -1,20 +1,17 @@
-// Whole runs of the evaluation commands on the caller's thread count. run_eval: dense flow of
-// every pair scored against its ground truth (eval::evaluate_pair), optionally with the HTML
-// report. run_sweep: a whole `roiflow sweep`: eval::sweep for each parameter in turn on the
-// caller's threads, sweep.csv rewritten after each parameter (an interrupted run keeps what is
-// complete) and one SVG plot per parameter, in an output folder that is created when missing (its
-// parent must exist: a mistyped path fails before minutes of computation).
+// Whole runs of the evaluation commands on a given thread count: run_flow (one pair, timed, and
+// its error), run_eval (every pair scored against its ground truth, optionally into the HTML
+// report) and run_sweep (`roiflow sweep`: eval::sweep for each parameter in turn, sweep.csv
+// rewritten after each, so an interrupted run keeps what is complete, and one SVG plot per
+// parameter, in an output folder created when missing; its parent must exist).
 //
 //   const auto pairs = roiflow::eval::find_middlebury("data/middlebury");
 //   const auto rows = roiflow::pipeline::run_eval(pairs, roiflow::flow::LkParams::paper(), 2);
 //   std::cout << roiflow::eval::format_table(rows);
-//
 //   roiflow::pipeline::SweepRunOptions o;
-//   o.pairs = roiflow::eval::find_middlebury("data/middlebury");
+//   o.pairs = pairs;
 //   o.plan = roiflow::eval::sweep_plan("patch", {}, o.base);
 //   o.out_dir = "out/sweep";
-//   const roiflow::pipeline::SweepRunResult r = roiflow::pipeline::run_sweep(o);
-//   std::cout << roiflow::eval::sweep_table(r.rows);
+//   std::cout << roiflow::eval::sweep_table(roiflow::pipeline::run_sweep(o).rows);
 #pragma once
 
 #include <functional>

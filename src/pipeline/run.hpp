@@ -5,13 +5,12 @@
 // Each returns what the run measured (frames, rates, per-stage times, peak memory, how it ended);
 // turning that into text or JSON is the caller's business.
 //
-//   using namespace roiflow;
-//   stages::VideoSource source("car.mp4", pipeline::source_params({}));
-//   pipeline::TrackRunOptions options;
+//   roiflow::stages::VideoSource source("car.mp4", roiflow::pipeline::source_params({}));
+//   roiflow::pipeline::TrackRunOptions options;
 //   options.tracker.init = cv::Rect2f(10, 20, 40, 30);
 //   options.log = "track.csv";
-//   const pipeline::TrackSummary s = pipeline::run_track_video(source, options);
-//   if (s.end == pipeline::RunEnd::InputStopped) return 1;  // s.status says where and why
+//   const roiflow::pipeline::TrackSummary s = roiflow::pipeline::run_track_video(source, options);
+//   if (s.end == roiflow::pipeline::RunEnd::InputStopped) std::cerr << s.status << "\n";
 #pragma once
 
 #include <atomic>

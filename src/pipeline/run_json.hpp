@@ -2,9 +2,11 @@
 // --summary` write): every field of the typed summary, in a fixed order, with the per-stage
 // times as report::stages_json gives them; and a tracking run's two lines for people.
 //
-//   roiflow::pipeline::TrackSummary s = roiflow::pipeline::run_track_video(source, options);
+//   roiflow::stages::VideoSource source("synthetic:10");
+//   const auto s = roiflow::pipeline::run_track_video(source, {});
 //   nlohmann::ordered_json doc = roiflow::pipeline::to_json(s);
 //   doc["input"] = s.input;  // callers add what their document needs beyond the run's figures
+//   std::cout << doc.dump(2) << "\n" << roiflow::pipeline::summary_text("track", s);
 #pragma once
 
 #include <nlohmann/json.hpp>
