@@ -55,6 +55,7 @@ int main(int argc, char** argv) {
   add_dense_command(app, exit_code);
   add_demo_command(app, exit_code);
   add_sweep_command(app, exit_code);
+  add_scaling_command(app, exit_code);
   add_benchmark_command(app, exit_code);
 
   try {

@@ -18,7 +18,7 @@ struct ScoreCommand {
 
 void run_score(const ScoreCommand& cmd) {
   if (cmd.mot) {
-    const auto truth = eval::read_mot(cmd.ground_truth, "ground truth");  // read first
+    const auto truth = eval::read_mot_truth(cmd.ground_truth);  // read first
     const eval::MotScore s = eval::score_mot(eval::read_mot(cmd.track, "tracker output"), truth);
     std::cout << (cmd.format == "json" ? mot_score_json(s).dump(2) + "\n" : mot_score_table(s));
     return;
@@ -57,7 +57,8 @@ void add_score_command(CLI::App& app, int& /*exit_code*/) {
       ->check(CLI::IsMember({"table", "json"}))
       ->capture_default_str();
   sub->add_flag("--mot", cmd.mot,
-                "multi-object: TRACK and GROUNDTRUTH are MOTChallenge files; CLEAR-MOT and IDF1");
+                "multi-object: TRACK and GROUNDTRUTH are MOTChallenge files (GROUNDTRUTH may be "
+                "synthetic:N[:WxH]:OBJECTS); CLEAR-MOT and IDF1");
   sub->callback([] { run_score(cmd); });
 }
 

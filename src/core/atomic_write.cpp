@@ -59,4 +59,17 @@ void check_output_path(const std::string& path, const std::string& option) {
   if (fs::is_directory(path, ec)) throw Error(option + ": '" + path + "' is a directory");
 }
 
+void make_output_dir(const std::string& dir, const std::string& option) {
+  std::error_code ec;
+  if (fs::is_directory(dir, ec)) return;
+  if (fs::exists(dir, ec)) throw Error(option + ": '" + dir + "' exists and is not a directory");
+  const fs::path parent = fs::path(dir).lexically_normal().parent_path();
+  if (!parent.empty() && !fs::is_directory(parent, ec)) {
+    throw Error(option + ": directory '" + parent.string() + "' of '" + dir + "' does not exist");
+  }
+  if (!fs::create_directory(dir, ec) && !fs::is_directory(dir)) {
+    throw Error(option + ": cannot create directory '" + dir + "': " + ec.message());
+  }
+}
+
 }  // namespace roiflow

@@ -30,5 +30,9 @@ void write_text_atomically(const std::string& path, const std::string& text);
 // Catches a mistyped output path before minutes of computation are spent: throws roiflow::Error
 // "<option>: directory 'd' of 'd/f' does not exist" or "<option>: 'p' is a directory".
 void check_output_path(const std::string& path, const std::string& option);
+// An output folder, created when missing; its parent must exist (a mistyped path fails before
+// minutes of computation instead of growing a tree somewhere unexpected). Throws roiflow::Error
+// "<option>: ..." otherwise.
+void make_output_dir(const std::string& dir, const std::string& option);
 
 }  // namespace roiflow

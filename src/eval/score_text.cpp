@@ -2,7 +2,27 @@
 
 #include <fmt/format.h>
 
+#include <filesystem>
+
+#include "core/error.hpp"
+#include "eval/synthetic_input.hpp"
+#include "eval/traffic_scene.hpp"
+
 namespace roiflow::eval {
+
+std::vector<MotBox> read_mot_truth(const std::string& gt) {
+  std::error_code ec;
+  if (!is_synthetic_input(gt) || std::filesystem::exists(gt, ec))
+    return read_mot(gt, "ground truth");
+  // A synthetic traffic input as ground truth: its exact boxes (as VideoSource reads inputs).
+  const SyntheticInput spec = parse_synthetic_input(gt);
+  if (spec.objects == 0) {
+    throw Error("ground truth '" + gt +
+                "': only synthetic inputs with OBJECTS (synthetic:N[:WxH]:OBJECTS) have "
+                "multi-object ground truth");
+  }
+  return TrafficScene(traffic_params(spec)).ground_truth();
+}
 
 std::string mot_score_table(const MotScore& s) {
   return fmt::format(

@@ -13,6 +13,9 @@
 
 namespace roiflow::eval {
 
+// The ground truth `roiflow score --mot` scores against: a MOTChallenge file, or the exact boxes
+// of a synthetic traffic input (synthetic:N[:WxH]:OBJECTS, when no such file exists).
+std::vector<MotBox> read_mot_truth(const std::string& gt);
 // MOTA, MOTP, IDF1 (IDP, IDR) to 4 decimals, ID switches, FP, FN, matches, frames, objects.
 std::string mot_score_table(const MotScore& s);
 // {"mota", "motp", "idf1", "id_switches", "fp", "fn", "frames", "objects"}.

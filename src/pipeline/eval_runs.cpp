@@ -13,19 +13,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-void prepare_out_dir(const std::string& dir) {
-  std::error_code ec;
-  if (fs::is_directory(dir, ec)) return;
-  if (fs::exists(dir, ec)) throw Error("--out: '" + dir + "' exists and is not a directory");
-  const fs::path parent = fs::path(dir).lexically_normal().parent_path();
-  if (!parent.empty() && !fs::is_directory(parent, ec)) {
-    throw Error("--out: directory '" + parent.string() + "' of '" + dir + "' does not exist");
-  }
-  if (!fs::create_directory(dir, ec) && !fs::is_directory(dir)) {
-    throw Error("--out: cannot create directory '" + dir + "': " + ec.message());
-  }
-}
-
 }  // namespace
 
 FlowRun run_flow(const eval::FlowInput& in, const flow::LkParams& params, int threads) {
@@ -57,7 +44,7 @@ std::vector<eval::EvalRow> run_eval(const std::vector<eval::EvalPair>& pairs,
 }
 
 SweepRunResult run_sweep(const SweepRunOptions& o) {
-  prepare_out_dir(o.out_dir);
+  make_output_dir(o.out_dir, "--out");
   const std::string csv_path = (fs::path(o.out_dir) / "sweep.csv").string();
   const TbbExecutor executor;
   SweepRunResult r;

@@ -1,8 +1,8 @@
 // Frames, in order, from a video file (FFmpeg), an image-sequence folder (OTB's img/ layout or
 // numbered files), a printf pattern ("img/%04d.jpg"), a camera index ("0") or a generated stream
-// ("synthetic:N[:WxH]"). Bad inputs and frame sizes out of the limits throw roiflow::Error at
-// construction (the first frame is decoded there); mid-stream the policy is STOP, never skip:
-// next() ends and status() says where and why. docs/STAGES.md has the details.
+// ("synthetic:N[:WxH][:OBJECTS]"). Bad inputs and frame sizes out of the limits throw
+// roiflow::Error at construction (the first frame is decoded there); mid-stream the policy is
+// STOP, never skip: next() ends and status() says where and why. docs/STAGES.md has details.
 //
 //   roiflow::stages::VideoSource source("synthetic:10");  // or "car.mp4", "data/Car4", "0"
 //   while (auto frame = source.next()) std::cout << frame->index << " " << frame->timestamp_s;

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "eval/mot.hpp"
+#include "eval/traffic_scene.hpp"
 #include "test_util.hpp"
 
 namespace {
@@ -76,6 +78,39 @@ TEST_F(CliMotScoreTest, BadFilesFailWithOneLine) {
   test::expect_one_error_line(run({"score", "--mot", path("pred.txt"), path("zero.txt")}), 1,
                               "no box to score");
   test::expect_one_error_line(run({"score", "--mot", path("pred.txt")}), 2, "GROUNDTRUTH");
+}
+
+TEST_F(CliMotScoreTest, SyntheticTrafficInputAsGroundTruth) {
+  eval::TrafficSceneParams p;
+  p.size = {320, 240};
+  p.frames = 30;
+  p.objects = 4;
+  std::vector<eval::MotBox> truth = eval::TrafficScene(p).ground_truth();
+  eval::write_mot(path("exact.txt"), truth);
+  CliResult r =
+      run({"score", "--mot", path("exact.txt"), "synthetic:30:320x240:4", "--format", "json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  nlohmann::json doc = nlohmann::json::parse(r.out);
+  EXPECT_DOUBLE_EQ(doc["mota"].get<double>(), 1.0);
+  EXPECT_DOUBLE_EQ(doc["idf1"].get<double>(), 1.0);
+  EXPECT_EQ(doc["frames"], 30);
+  // One vehicle dropped: its boxes are all misses.
+  const int dropped = truth.front().id;
+  long long boxes = 0;
+  std::erase_if(truth, [&](const eval::MotBox& b) {
+    boxes += b.id == dropped;
+    return b.id == dropped;
+  });
+  eval::write_mot(path("missing.txt"), truth);
+  r = run({"score", "--mot", path("missing.txt"), "synthetic:30:320x240:4", "--format", "json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  doc = nlohmann::json::parse(r.out);
+  EXPECT_EQ(doc["fn"], boxes);
+  EXPECT_LT(doc["mota"].get<double>(), 1.0);
+  test::expect_one_error_line(run({"score", "--mot", path("exact.txt"), "synthetic:30"}), 1,
+                              "only synthetic inputs with OBJECTS");
+  test::expect_one_error_line(run({"score", "--mot", path("exact.txt"), "synthetic:30:999"}), 1,
+                              "bad synthetic input 'synthetic:30:999'");
 }
 
 }  // namespace
