@@ -51,7 +51,10 @@ void run_flow(const FlowCommand& cmd) {
   std::vector<std::string> written{cmd.output};
   eval::write_flo(cmd.output, r.flow);
   if (!cmd.color.empty()) {
-    eval::write_image_atomically(written.emplace_back(cmd.color), flow::flow_to_color(r.flow));
+    // Against a ground truth, the truth's largest vector saturates, so the two pictures compare.
+    const float scale = in.truth.empty() ? -1.f : flow::max_magnitude(in.truth);
+    eval::write_image_atomically(written.emplace_back(cmd.color),
+                                 flow::flow_to_color(r.flow, scale));
   }
   if (!cmd.legend.empty()) {
     eval::write_image_atomically(written.emplace_back(cmd.legend), flow::color_wheel_legend());
@@ -82,7 +85,10 @@ void add_flow_command(CLI::App& app, int& /*exit_code*/) {
   sub->add_option("-o,--output", cmd.output, "the flow, Middlebury .flo")
       ->type_name("FLO")
       ->required();
-  sub->add_option("--color", cmd.color, "the flow in Middlebury colour coding")->type_name("IMAGE");
+  sub->add_option("--color", cmd.color,
+                  "the flow in Middlebury colour coding, saturated at the 99th percentile of its "
+                  "magnitudes (with --gt: at the truth's largest)")
+      ->type_name("IMAGE");
   sub->add_option("--legend", cmd.legend, "the colour wheel, as a legend")->type_name("IMAGE");
   sub->add_option("--gt", cmd.ground_truth, "ground-truth flow: print the error against it")
       ->type_name("FLO");

@@ -20,7 +20,7 @@ FUNCTION_MAX_LINES = 120
 SOURCE_DIRS = ("src", "apps", "tests", "bench", "fuzz")
 EXTENSIONS = (".cpp", ".hpp", ".h", ".cc")
 # Files another piece of work is rewriting; their limits are checked once it has landed.
-EXEMPT = {"src/stages/local_tracker.cpp"}
+EXEMPT = set()
 
 SCOPE_HEADER = re.compile(r'\b(namespace|class|struct|union|enum)\b|extern\s+"C"')
 

@@ -72,4 +72,14 @@ void make_output_dir(const std::string& dir, const std::string& option) {
   }
 }
 
+void write_bytes_atomically(const std::string& path, const std::string& what, const void* data,
+                            std::size_t size) {
+  write_atomically(path, what, [&](const std::string& partial) {
+    std::ofstream out(partial, std::ios::binary);
+    out.write(static_cast<const char*>(data), static_cast<std::streamsize>(size));
+    out.close();
+    return static_cast<bool>(out);
+  });
+}
+
 }  // namespace roiflow

@@ -13,6 +13,7 @@
 //   });
 #pragma once
 
+#include <cstddef>
 #include <functional>
 #include <opencv2/core.hpp>
 #include <string>
@@ -26,6 +27,9 @@ void write_atomically(const std::string& path, const std::string& what,
                       const std::function<bool(const std::string& partial_path)>& write);
 
 void write_text_atomically(const std::string& path, const std::string& text);
+// `size` bytes from `data` (e.g. an image encoded in memory by cv::imencode).
+void write_bytes_atomically(const std::string& path, const std::string& what, const void* data,
+                            std::size_t size);
 
 // Catches a mistyped output path before minutes of computation are spent: throws roiflow::Error
 // "<option>: directory 'd' of 'd/f' does not exist" or "<option>: 'p' is a directory".

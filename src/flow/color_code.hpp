@@ -1,10 +1,13 @@
 // Middlebury colour coding of flow (Baker et al. 2011; the paper's Fig. 10): hue gives the
 // direction (the 55-colour Middlebury wheel), saturation the magnitude relative to
-// `max_magnitude` (<= 0: the largest known magnitude in the field); unknown pixels (|u| or |v| >
-// 1e9, NaN) are black. Also the wheel as a legend and arrows drawn over an image.
+// `max_magnitude` (<= 0: the field's robust maximum, a high percentile of its magnitudes, so
+// that a few wild vectors do not wash the picture out; beyond it hues darken); unknown pixels
+// are black. To compare an estimate with its ground truth, colour both with the truth's
+// max_magnitude(). Also the wheel as a legend and arrows drawn over an image.
 //
 //   const cv::Mat flow(frame_t.size(), CV_32FC2, cv::Scalar(1.5f, -0.5f));
 //   const cv::Mat coded = roiflow::flow::flow_to_color(flow);     // CV_8UC3, for cv::imwrite
+//   const cv::Mat scaled = roiflow::flow::flow_to_color(flow, roiflow::flow::max_magnitude(flow));
 //   const cv::Mat legend = roiflow::flow::color_wheel_legend(151);
 //   const cv::Mat arrows = roiflow::flow::draw_flow_vectors(bgr, flow, 16);
 #pragma once
@@ -13,7 +16,15 @@
 
 namespace roiflow::flow {
 
+// Percentile (of the known magnitudes) flow_to_color saturates at by default.
+inline constexpr double kRobustMagnitudePercentile = 99.0;
+
 cv::Mat flow_to_color(const cv::Mat& flow, float max_magnitude = -1.f);
+// The nearest-rank `percentile` (in (0, 100]) of the known vectors' magnitudes of a CV_32FC2
+// field; 0 when none is known. Throws roiflow::Error on another type or percentile.
+float robust_max_magnitude(const cv::Mat& flow, double percentile = kRobustMagnitudePercentile);
+// The largest known magnitude (robust_max_magnitude at 100).
+float max_magnitude(const cv::Mat& flow);
 // A square legend of side `size` >= 3 (odd sizes centre exactly): each pixel coloured by its
 // own offset from the centre, the inscribed circle's rim at full magnitude; white outside the
 // circle (black would read as "unknown").

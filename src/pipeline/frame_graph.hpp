@@ -1,7 +1,8 @@
 // The oneTBB flow graphs that run roiflow over a video. Tracking mode: decoding and pyramids of
 // later frames run ahead of the serial tracker, bounded by a limiter (at most `max_in_flight`
 // frames alive), and every sink sees every frame once, in order. Dense mode: each frame is
-// paired with the previous one and several pairs' flow runs at once, in order for the sinks.
+// paired with the previous one, several pairs' flow and the sinks' parallel parts
+// (FlowSink::prepare) run at once, and the sinks' ordered parts see the pairs in order.
 // An exception anywhere cancels the graph and is rethrown once the running nodes are done; a
 // cancel flag stops the source and finishes the frames in flight. docs/ARCHITECTURE.md, "The
 // graphs", draws them.
@@ -97,11 +98,19 @@ struct FlowPair {
   std::shared_ptr<const stages::Frame> frame_t;
   std::shared_ptr<const stages::Frame> frame_t1;
   std::shared_ptr<const flow::FlowResult> flow;  // whole-frame flow t -> t+1
+  // In FlowSink::consume: what that sink's `prepare` made of this pair (empty without one).
+  cv::Mat prepared = {};
 };
 
+// A sink of dense mode in two parts. `prepare` (optional, thread-safe) is the costly, parallel
+// part, e.g. colour coding and PNG encoding: it runs on several pairs at once, in any order, as
+// soon as a pair's flow exists (its time is the "<name>.prepare" stage). `consume` is the
+// ordered part, e.g. the write: one pair at a time, in pair order, with FlowPair::prepared set
+// to what `prepare` returned for that pair.
 struct FlowSink {
   std::string name;
   std::function<void(const FlowPair&)> consume;
+  std::function<cv::Mat(const FlowPair&)> prepare = {};
 };
 
 RunReport run_dense(const FrameSource& source, const flow::LkParams& params,

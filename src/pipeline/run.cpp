@@ -8,7 +8,7 @@
 
 #include "core/error.hpp"
 #include "core/text.hpp"
-#include "flow/color_code.hpp"
+#include "pipeline/dense_outputs.hpp"
 #include "pipeline/tbb_executor.hpp"
 #include "report/annotate.hpp"
 #include "report/progress.hpp"
@@ -148,24 +148,28 @@ TrackSummary run_track_video(stages::VideoSource& source, const TrackRunOptions&
 }
 
 DenseSummary run_dense_video(stages::VideoSource& source, const DenseRunOptions& options) {
-  stages::VideoSink video(options.video, source.fps(), source.size());
+  DenseOutputOptions wanted;
+  wanted.video = options.video;
+  wanted.flow_dir = options.flow_dir;
+  wanted.flow_format = options.flow_format;
+  wanted.max_motion = options.max_motion;
+  DenseOutputs outputs(wanted, source.fps(), source.size());
+  std::vector<FlowSink> sinks = outputs.sinks();
   const long long hint = source.frame_count_hint();
   report::Progress progress(std::cerr, hint > 1 ? hint - 1 : hint,
                             options.progress && report::Progress::stderr_is_terminal());
+  sinks.push_back({"progress", [&](const FlowPair& p) { progress.update(p.seq + 1); }});
   report::RunStats stats;
-  const float max_motion = static_cast<float>(options.max_motion > 0 ? options.max_motion : -1.0);
-  const RunReport report = run_dense(
-      [&] { return source.next(); }, options.lk,
-      {{"video",
-        [&](const FlowPair& p) { video.write(flow::flow_to_color(p.flow->flow, max_motion)); }},
-       {"progress", [&](const FlowPair& p) { progress.update(p.seq + 1); }}},
-      graph_options(options.threads, options.max_in_flight, options.cancel, &stats));
+  const RunReport report =
+      run_dense([&] { return source.next(); }, options.lk, sinks,
+                graph_options(options.threads, options.max_in_flight, options.cancel, &stats));
   progress.finish();
-  video.close();
+  outputs.close();
 
   DenseSummary s;
   s.stages = stats.totals();
   s.input = source.description();
+  s.outputs = outputs.description();
   s.end = run_end(report, &source.status());
   s.status = source.status().message;
   s.frames = report.frames;

@@ -22,6 +22,7 @@
 #include "eval/track_log.hpp"
 #include "pipeline/frame_graph.hpp"
 #include "report/run_stats.hpp"
+#include "stages/flow_file_sink.hpp"
 #include "stages/tracker.hpp"
 #include "stages/video_source.hpp"
 
@@ -103,6 +104,7 @@ struct DenseRunOptions {
 
 struct DenseSummary {
   std::string input;
+  std::string outputs;  // what was written (DenseOutputs::description)
   RunEnd end = RunEnd::Complete;
   std::string status;
   long long frames = 0;

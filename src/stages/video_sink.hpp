@@ -4,6 +4,8 @@
 //
 //   roiflow::stages::VideoSink sink("run/annotated.mp4", 25.0, bgr.size());
 //   sink.write(bgr);  // 8-bit BGR or gray, of that size
+//   const cv::Mat png = sink.encode(bgr);  // on any thread (a parallel graph node) ...
+//   sink.write_encoded(png);               // ... then written in order
 //   std::cerr << sink.description() << ": " << sink.frames() << " frames\n";
 //   sink.close();  // or let the destructor do it
 #pragma once
@@ -26,6 +28,12 @@ class VideoSink {
   VideoSink& operator=(VideoSink&&) noexcept;
 
   void write(const cv::Mat& frame);
+  // write() in two parts, so that the costly one runs on several frames at once: encode() is
+  // const and thread-safe (it checks the frame, converts gray to BGR and, for a PNG folder,
+  // encodes the PNG: a 1xN CV_8U row of its bytes); write_encoded() writes what encode()
+  // returned, in order, one at a time. write(f) is write_encoded(encode(f)).
+  cv::Mat encode(const cv::Mat& frame) const;
+  void write_encoded(const cv::Mat& encoded);
   void close();
 
   long long frames() const;  // written so far
