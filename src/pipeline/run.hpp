@@ -96,8 +96,10 @@ struct DenseRunOptions {
   flow::LkParams lk = flow::LkParams::paper();
   int threads = 1;
   int max_in_flight = 0;
-  std::string video;      // colour-coded flow: a video or a folder of PNGs; required
-  double max_motion = 0;  // pixels at full colour saturation; 0 = each pair's own maximum
+  std::string video;     // colour-coded flow: a video or a folder of PNGs; empty = none
+  std::string flow_dir;  // raw flow, one file per pair; empty = none (one of the two is needed)
+  stages::FlowFileFormat flow_format = stages::FlowFileFormat::Flo;
+  double max_motion = 0;  // pixels at full colour saturation; 0 = each pair's robust maximum
   bool progress = false;
   const std::atomic<bool>* cancel = nullptr;
 };
