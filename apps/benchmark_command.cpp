@@ -13,6 +13,7 @@ namespace {
 struct BenchmarkCommand {
   LkOptions lk;
   std::string out;
+  bool tracks = false;
   pipeline::BenchmarkOptions run;  // DIR, --trackers, --sequences, --max-frames, --roi, ...
   bool progress = true;
 };
@@ -40,7 +41,7 @@ void run_benchmark_command(const BenchmarkCommand& cmd) {
     };
   }
   const pipeline::BenchmarkResult result = pipeline::run_benchmark(options);
-  const std::vector<std::string> written = pipeline::write_benchmark(result, cmd.out);
+  const std::vector<std::string> written = pipeline::write_benchmark(result, cmd.out, cmd.tracks);
   std::cout << eval::format_benchmark_markdown(result.rows, result.means) << "\nbenchmarked "
             << result.means.size() << " trackers on "
             << result.rows.size() / std::max<std::size_t>(1, result.means.size()) << " sequences, "
@@ -86,6 +87,10 @@ void add_benchmark_command(CLI::App& app, int& /*exit_code*/) {
                   "(0 = always full resolution)")
       ->check(CLI::Range(0.0, 100.0))
       ->capture_default_str();
+  sub->add_flag(
+      "--tracks", cmd.tracks,
+      "also write every run's track log, OUT/tracks/<sequence>/<tracker>.csv (the format of "
+      "roiflow track --log; roiflow score reads it)");
   sub->add_flag("!--no-progress", cmd.progress, "no line per finished sequence on stderr");
   cmd.lk.threads = pipeline::default_threads();
   add_lk_options(*sub, cmd.lk);

@@ -46,5 +46,6 @@ void add_demo_command(CLI::App& app, int& exit_code);
 void add_sweep_command(CLI::App& app, int& exit_code);
 void add_benchmark_command(CLI::App& app, int& exit_code);
 void add_scaling_command(CLI::App& app, int& exit_code);
+void add_batch_command(CLI::App& app, int& exit_code);
 
 }  // namespace roiflow::cli
