@@ -1,57 +1,51 @@
-// Pieces the roiflow subcommands share: the usage error, the Lucas-Kanade options, output
-// checks and atomic writes, number formatting.
+// What the roiflow subcommands share: the Lucas-Kanade options (declared once, added to any
+// subcommand), output checks, a video run's options and summary line. A new subcommand lives in
+// apps/<name>_command.cpp: add_<name>_command declares its options, its callback calls a library
+// function and prints the result; one declaration below and one line in main() register it.
 #pragma once
 
 #include <CLI/CLI.hpp>
-#include <opencv2/core.hpp>
-#include <optional>
+#include <functional>
 #include <string>
+#include <vector>
 
+#include "core/atomic_write.hpp"
 #include "core/error.hpp"
-#include "flow/dense_lk.hpp"
-#include "flow/metrics.hpp"
+#include "core/text.hpp"
+#include "pipeline/run.hpp"
+#include "pipeline/signals.hpp"
+#include "pipeline/tbb_executor.hpp"
 
 namespace roiflow::cli {
 
-// A command line that CLI11 accepts but that makes no sense (conflicting inputs, LK
-// parameters out of range): reported like CLI11's own parse errors, with exit code 2.
-class UsageError : public Error {
- public:
-  using Error::Error;
-};
-
-// Overrides stay empty unless given, so they apply on top of whichever preset was chosen.
+// The preset and the overrides given on the command line, applied on top of it in order.
 struct LkOptions {
   std::string preset = "paper";
-  std::optional<int> patch, iterations, level_median, final_median;
-  std::optional<std::string> levels;  // N or "auto"
-  std::optional<int> coarsest_side, search_radius, fuse_far_step, fuse_far_finest_level;
-  std::optional<int> fuse_step, fuse_finest_level, mask_outside, finest_level;
-  std::optional<double> expected_motion;
-  std::optional<double> sigma, lambda, robust_scale;
-  std::optional<std::string> derivative;
+  std::vector<std::function<void(flow::LkParams&)>> overrides;
   int threads = 1;
 };
 
+// Adds --preset, the overrides and --threads (default `lk.threads`) to `cmd`.
 void add_lk_options(CLI::App& cmd, LkOptions& lk);
 // The preset with the overrides applied; out-of-range values throw UsageError.
 flow::LkParams lk_params(const LkOptions& lk);
 
-std::string size_string(cv::Size size);
-std::string fixed(double value, int decimals);
-std::string errors_line(const flow::FlowErrors& e);
+// --out (to `video`), --summary and --no-progress.
+void add_run_outputs(CLI::App& sub, std::string& video, std::string& summary, bool& progress,
+                     const std::string& video_help);
+// --start, --max-frames, --in-flight, --decode-threads.
+void add_source_options(CLI::App& sub, pipeline::SourceOptions& source, int& in_flight);
 
-// Catches a mistyped output path before minutes of computation are spent.
-void check_output_path(const std::string& path, const std::string& option);
-void check_image_output(const std::string& path, const std::string& option);
-
-// roiflow track, dense and demo (video_commands.cpp); a run's exit code goes to `exit_code`.
-void add_video_commands(CLI::App& app, int& exit_code);
-void add_sweep_command(CLI::App& app);      // roiflow sweep (sweep_command.cpp)
-void add_benchmark_command(CLI::App& app);  // roiflow benchmark (benchmark_command.cpp)
-void add_scaling_command(CLI::App& app);    // roiflow scaling (scaling_command.cpp)
-void add_batch_command(CLI::App& app, int& exit_code);  // roiflow batch (batch_command.cpp)
-// roiflow score --mot PRED GT (mot_score_command.cpp)
-void print_mot_score(const std::string& pred, const std::string& gt, const std::string& format);
+// The subcommands; a video run's exit code goes to `exit_code`.
+void add_flow_command(CLI::App& app, int& exit_code);
+void add_eval_command(CLI::App& app, int& exit_code);
+void add_score_command(CLI::App& app, int& exit_code);
+void add_track_command(CLI::App& app, int& exit_code);
+void add_dense_command(CLI::App& app, int& exit_code);
+void add_demo_command(CLI::App& app, int& exit_code);
+void add_sweep_command(CLI::App& app, int& exit_code);
+void add_benchmark_command(CLI::App& app, int& exit_code);
+void add_scaling_command(CLI::App& app, int& exit_code);
+void add_batch_command(CLI::App& app, int& exit_code);
 
 }  // namespace roiflow::cli

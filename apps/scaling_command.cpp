@@ -11,7 +11,6 @@
 
 #include "cli_common.hpp"
 #include "core/atomic_write.hpp"
-#include "core/error.hpp"
 #include "pipeline/scaling.hpp"
 #include "report/plot.hpp"
 
@@ -30,20 +29,6 @@ struct ScalingCommand {
   int repeats = 1;
 };
 
-// The output folder is created when missing; its parent must exist.
-void prepare_out_dir(const std::string& dir) {
-  std::error_code ec;
-  if (fs::is_directory(dir, ec)) return;
-  if (fs::exists(dir, ec)) throw Error("--out: '" + dir + "' exists and is not a directory");
-  const fs::path parent = fs::path(dir).lexically_normal().parent_path();
-  if (!parent.empty() && !fs::is_directory(parent, ec)) {
-    throw Error("--out: directory '" + parent.string() + "' of '" + dir + "' does not exist");
-  }
-  if (!fs::create_directory(dir, ec) && !fs::is_directory(dir)) {
-    throw Error("--out: cannot create directory '" + dir + "': " + ec.message());
-  }
-}
-
 void run_scaling_command(const ScalingCommand& cmd) {
   pipeline::ScalingOptions o;
   o.input = cmd.input;
@@ -57,7 +42,7 @@ void run_scaling_command(const ScalingCommand& cmd) {
   } catch (const Error& e) {
     throw UsageError(e.what());
   }
-  prepare_out_dir(cmd.out);
+  make_output_dir(cmd.out, "--out");
   const pipeline::ScalingResult r = pipeline::run_scaling(o);
   const std::string csv = (fs::path(cmd.out) / "scaling.csv").string();
   const std::string svg = (fs::path(cmd.out) / "scaling.svg").string();
@@ -74,7 +59,7 @@ void run_scaling_command(const ScalingCommand& cmd) {
 
 }  // namespace
 
-void add_scaling_command(CLI::App& app) {
+void add_scaling_command(CLI::App& app, int& /*exit_code*/) {
   static ScalingCommand cmd;
   CLI::App* sub = app.add_subcommand(
       "scaling", "The same run at several thread counts: fps, speedup, efficiency; CSV and SVG");

@@ -1,23 +1,14 @@
-// Optimal assignment (the linear assignment problem) for rectangular cost matrices with a gate:
-// the pairing of rows to columns, each used at most once, that first holds as many allowed
-// pairs as possible and then has the smallest total cost among those. A pair is allowed when
-// its cost is finite and not above `max_cost`. This is how py-motmetrics matches ground truth
-// to hypotheses (scipy's linear_sum_assignment after replacing the gated pairs by a cost so
-// large that no optimum uses one while an allowed pairing exists) and how a tracker assigns
-// detections to predicted tracks without going greedy. The solver is the shortest augmenting
-// path form of the Hungarian method (Kuhn-Munkres with potentials, as Jonker-Volgenant
-// arrange it): O(n^2 m) for n = min(rows, cols), m = max(rows, cols).
+// Optimal assignment for rectangular cost matrices with a gate: the pairing of rows to columns,
+// each used at most once, that first holds as many allowed pairs as possible (a pair is allowed
+// when its cost is finite and not above `max_cost`) and then has the smallest total cost among
+// those. It is how py-motmetrics matches ground truth to hypotheses and how a tracker assigns
+// detections to tracks without going greedy. Hungarian method with potentials, O(n^2 m) for
+// n = min(rows, cols), m = max(rows, cols). To maximise weights, pass them negated, no gate.
 //
-//   // rows: tracks, cols: detections; cost = 1 - IoU, pairs under IoU 0.3 not allowed
-//   std::vector<double> cost(tracks * detections);
-//   ...
-//   const roiflow::Assignment a = roiflow::solve_assignment(cost, tracks, detections, 0.7);
-//   for (int t = 0; t < tracks; ++t)
-//     if (a.row_to_col[t] >= 0) { /* track t takes detection a.row_to_col[t] */ }
-//
-// To maximise a total weight instead (every pair allowed, zero weight meaning "no gain"),
-// pass the negated weights and no gate: with every pair allowed the most pairs is always
-// min(rows, cols), so only the total counts.
+//   const std::vector<double> cost = {0.1, 0.9,   // rows: tracks, cols: detections (1 - IoU)
+//                                     0.8, 0.2};
+//   const roiflow::Assignment a = roiflow::solve_assignment(cost, 2, 2, /*max_cost=*/0.7);
+//   std::cout << a.row_to_col[0] << " " << a.row_to_col[1] << "\n";  // 0 1
 #pragma once
 
 #include <limits>

@@ -50,6 +50,28 @@ void write_text_atomically(const std::string& path, const std::string& text) {
   });
 }
 
+void check_output_path(const std::string& path, const std::string& option) {
+  const fs::path parent = fs::path(path).parent_path();
+  std::error_code ec;
+  if (!parent.empty() && !fs::is_directory(parent, ec)) {
+    throw Error(option + ": directory '" + parent.string() + "' of '" + path + "' does not exist");
+  }
+  if (fs::is_directory(path, ec)) throw Error(option + ": '" + path + "' is a directory");
+}
+
+void make_output_dir(const std::string& dir, const std::string& option) {
+  std::error_code ec;
+  if (fs::is_directory(dir, ec)) return;
+  if (fs::exists(dir, ec)) throw Error(option + ": '" + dir + "' exists and is not a directory");
+  const fs::path parent = fs::path(dir).lexically_normal().parent_path();
+  if (!parent.empty() && !fs::is_directory(parent, ec)) {
+    throw Error(option + ": directory '" + parent.string() + "' of '" + dir + "' does not exist");
+  }
+  if (!fs::create_directory(dir, ec) && !fs::is_directory(dir)) {
+    throw Error(option + ": cannot create directory '" + dir + "': " + ec.message());
+  }
+}
+
 void write_bytes_atomically(const std::string& path, const std::string& what, const void* data,
                             std::size_t size) {
   write_atomically(path, what, [&](const std::string& partial) {

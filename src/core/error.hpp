@@ -1,9 +1,14 @@
-// roiflow::Error — the one exception type of the library.
+// The library's exceptions. roiflow::Error is thrown for every bad argument, file or value, with
+// a message that names the offending value, so a command line can print it on one line.
+// roiflow::UsageError is the kind of Error that a request makes before any input is read (a
+// parameter out of range, conflicting options): the CLI exits with code 2 for it, 1 otherwise.
 //
-//   if (patch < 3) throw roiflow::Error(fmt("patch must be in 3..31, got {}", patch));
-//
-// Every bad argument (wrong size, absurd parameter, corrupt file) throws this with a message
-// that names the offending value, so the CLI can print it on one line and exit non-zero.
+//   const int patch = 40;
+//   try {
+//     if (patch > 31) throw roiflow::UsageError("patch must be in 3..31, got 40");
+//   } catch (const roiflow::Error& e) {
+//     std::cerr << e.what() << "\n";
+//   }
 #pragma once
 
 #include <stdexcept>
@@ -14,6 +19,13 @@ namespace roiflow {
 class Error : public std::runtime_error {
  public:
   explicit Error(const std::string& what) : std::runtime_error(what) {}
+};
+
+// A request that makes no sense before any input is read (conflicting options, a parameter out
+// of range, a box outside the frame): the CLI reports it like a command-line error (exit code 2).
+class UsageError : public Error {
+ public:
+  using Error::Error;
 };
 
 }  // namespace roiflow

@@ -1,14 +1,15 @@
-// Executor — how the flow core runs independent row stripes.
+// How the flow core runs independent row stripes, without knowing threads: a caller that wants
+// them parallel passes an Executor whose for_range may run body(begin, end) on disjoint
+// sub-ranges of [begin, end) at once (the pipeline's TbbExecutor does). start(job) runs a job
+// beside the caller, who calls wait() on the handle before touching what the job touches.
+// SerialExecutor runs everything on the caller's thread.
 //
-//   roiflow::SerialExecutor serial;            // the default: one thread
-//   dense_flow(a, b, params, {}, &serial);
-//
-// src/flow knows no threads. A caller that wants parallel stripes (the pipeline does it with
-// tbb::parallel_for) passes an Executor whose for_range may run body(begin, end) on disjoint
-// sub-ranges of [begin, end) concurrently. Bodies never share writable state.
-//
-// start(job) runs a job beside the caller (the tracker's background-model refresh): the caller
-// goes on and calls wait() on the handle before it touches what the job touches again.
+//   const roiflow::SerialExecutor serial;
+//   std::vector<int> rows(480);
+//   serial.for_range(0, 480, 16, [&](int begin, int end) {
+//     for (int y = begin; y < end; ++y) rows[y] = y;
+//   });
+//   serial.start([] { std::cout << "side job\n"; })->wait();
 #pragma once
 
 #include <functional>

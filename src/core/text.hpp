@@ -1,17 +1,42 @@
-// Text for the places it is shown: numbers as the user wrote them, values quoted for an error
-// message, and text made safe for HTML or SVG.
+// Text for the places it is shown: numbers with fixed decimals (libfmt), sizes, lists, numbers
+// as the user wrote them, values quoted for an error message, and text made safe for HTML/SVG.
 //
-//   throw Error("roi must be in 8..4096, got " + number_text(roi));
-//   throw Error(path + ":" + std::to_string(line) + ": bad number " + quoted_excerpt(field));
-//   svg += "<text>" + escape_markup(label) + "</text>";
+//   std::string line = "EPE " + roiflow::fixed(0.12345, 3) + " px at " +
+//                      roiflow::size_text({640, 480});          // "EPE 0.123 px at 640x480"
+//   line += " (" + roiflow::joined({"a.csv", "b.svg"}) + ")";   // "(a.csv, b.svg)"
+//   const std::string error = "bad number " + roiflow::quoted_excerpt("12x") + ", roi " +
+//                             roiflow::number_text(0.5);        // "bad number '12x', roi 0.5"
+//   const std::string svg = "<text>" + roiflow::escape_markup("a < b") + "</text>";
 #pragma once
 
+#include <fmt/format.h>
+
 #include <cstddef>
+#include <opencv2/core/types.hpp>
 #include <sstream>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace roiflow {
+
+// A number with a fixed count of decimals, like printf's "%.*f": fixed(3.14159, 2) is "3.14".
+inline std::string fixed(double value, int decimals) {
+  return fmt::format("{:.{}f}", value, decimals);
+}
+
+// "640x480".
+inline std::string size_text(cv::Size size) {
+  return fmt::format("{}x{}", size.width, size.height);
+}
+
+// "a, b, c" (with the default separator).
+inline std::string joined(const std::vector<std::string>& items, std::string_view sep = ", ") {
+  std::string list;
+  for (const std::string& item : items)
+    list += (list.empty() ? "" : std::string(sep)) + item;
+  return list;
+}
 
 // A number as error messages show it: the shortest stream form ("0.5", "1e-06", "nan"), so that
 // the value the user gave reads back as they wrote it.

@@ -1,7 +1,10 @@
-// Line-oriented text input shared by the track-log and ground-truth parsers.
+// Line-oriented text input shared by the track-log and ground-truth parsers: the whole file (an
+// error names it and what it is), and its lines without '\n' or a Windows '\r'.
 //
-//   const std::string text = read_text_file(path, "ground truth");  // throws roiflow::Error
-//   for_each_line(text, [&](long long number, std::string_view line) { ... });
+//   const std::string text = "x\r\ny\n";  // or roiflow::read_text_file(path, "ground truth")
+//   roiflow::for_each_line(text, [](long long number, std::string_view line) {
+//     std::cout << number << ": " << line << "\n";
+//   });
 #pragma once
 
 #include <filesystem>

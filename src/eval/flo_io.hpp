@@ -1,13 +1,12 @@
-// Middlebury .flo read/write.
+// Middlebury .flo files: float32 magic 202021.25, int32 width and height, then the (u, v) float32
+// pairs, little-endian, rows top to bottom; unknown pixels (|u| or |v| > 1e9) are kept as they
+// are. read_flo throws roiflow::Error naming the file and the fault for a missing file, a bad
+// magic, absurd dimensions (checked against the file size before allocating), a truncated or
+// over-long file, or NaN values; write_flo writes atomically.
 //
-//   cv::Mat gt = roiflow::eval::read_flo("flow10.flo");   // CV_32FC2
+//   const cv::Mat flow(frame_t.size(), CV_32FC2, cv::Scalar(0.5f, -1.f));
 //   roiflow::eval::write_flo("out.flo", flow);
-//
-// Format: float32 magic 202021.25, int32 width, int32 height, then height*width (u, v) float32
-// pairs, little-endian, rows top to bottom. Unknown pixels have |u| or |v| > 1e9 and are kept
-// as they are. read_flo throws roiflow::Error (naming the file and what is wrong) on a missing
-// file, bad magic, non-positive or absurd dimensions (checked against the file size before
-// any allocation), a truncated or over-long file, or NaN values.
+//   const cv::Mat back = roiflow::eval::read_flo("out.flo");  // CV_32FC2, bit for bit
 #pragma once
 
 #include <opencv2/core.hpp>

@@ -10,6 +10,7 @@
 #include <system_error>
 
 #include "core/error.hpp"
+#include "core/text.hpp"
 #include "eval/flo_io.hpp"
 #include "eval/kitti_flow.hpp"
 
@@ -105,21 +106,11 @@ cv::Mat mask_union(const cv::Mat& a, const cv::Mat& b) {
   return a | b;
 }
 
-std::string size_string(cv::Size size) {
-  return std::to_string(size.width) + "x" + std::to_string(size.height);
-}
-
 void check_same_size(const std::string& name, const std::string& path_a, cv::Size a,
                      const std::string& path_b, cv::Size b) {
   if (a == b) return;
-  throw Error("size mismatch in pair '" + name + "': '" + path_a + "' is " + size_string(a) +
-              " but '" + path_b + "' is " + size_string(b));
-}
-
-std::string fixed(double value, int decimals) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
-  return buffer;
+  throw Error("size mismatch in pair '" + name + "': '" + path_a + "' is " + size_text(a) +
+              " but '" + path_b + "' is " + size_text(b));
 }
 
 // Sequence names come from folder names, which may hold anything a CSV reader trips on.

@@ -1,18 +1,16 @@
-// Flow evaluation against ground truth: Middlebury, MPI-Sintel and KITTI trees, or explicit
-// image pairs.
+// Flow evaluation against ground truth over Middlebury, MPI-Sintel and KITTI trees or explicit
+// pairs: every pair is loaded as 8-bit gray, checked, run through dense LK (timed alone, file
+// I/O excluded) and scored with flow::flow_errors over all scored pixels and, where the dataset
+// marks occlusions (Sintel masks, KITTI flow_noc), over the non-occluded ones; then the rows are
+// formatted as a table, CSV or JSON. Missing files, size mismatches, broken trees and pairs with
+// nothing to score throw roiflow::Error naming the file or pair.
 //
-//   using namespace roiflow;
-//   std::vector<eval::EvalRow> rows;
-//   for (const auto& pair : eval::find_pairs("data/sintel/training", {.max_pairs = 20}))
-//     rows.push_back(eval::evaluate_pair(pair, flow::LkParams::paper()));
-//   std::cout << eval::format_table(rows);   // one row per pair, then the mean
-//
-// Every pair is loaded as 8-bit gray, checked (all sizes equal), run through flow::dense_flow
-// (timed alone, file I/O excluded) and scored with flow::flow_errors over all scored pixels
-// and, when the pair says which pixels are occluded (a Sintel occlusion mask, a KITTI flow_noc
-// file), over the non-occluded ones too. Missing or unreadable files, size mismatches, broken
-// trees and a pair with no pixel to score throw roiflow::Error naming the file, the sizes or
-// the pair.
+//   roiflow::eval::FindOptions find;
+//   find.max_pairs = 20;
+//   std::vector<roiflow::eval::EvalRow> rows;
+//   for (const auto& pair : roiflow::eval::find_pairs("data/sintel/training", find))
+//     rows.push_back(roiflow::eval::evaluate_pair(pair, roiflow::flow::LkParams::paper()));
+//   std::cout << roiflow::eval::format_table(rows);  // one row per pair, then the mean
 #pragma once
 
 #include <nlohmann/json.hpp>

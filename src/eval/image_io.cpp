@@ -95,4 +95,12 @@ void write_image_atomically(const std::string& path, const cv::Mat& image) {
                    [&](const std::string& partial) { return cv::imwrite(partial, image); });
 }
 
+void check_image_output(const std::string& path, const std::string& option) {
+  check_output_path(path, option);
+  if (!cv::haveImageWriter(path)) {
+    throw UsageError(option + ": cannot write an image named '" + path +
+                     "' (use an extension such as .png)");
+  }
+}
+
 }  // namespace roiflow::eval

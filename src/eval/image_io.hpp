@@ -1,9 +1,12 @@
-// Image files in and out, with the frame-size limits every input obeys: the reader that refuses
-// truncated or damaged PNG and JPEG files, and the atomic image writer.
+// Image files in and out, with the frame-size limits every input obeys: a reader that refuses
+// truncated or damaged PNG and JPEG files (decoders would report them only on stderr, or answer
+// with a half-gray picture), and an atomic writer.
 //
-//   cv::Mat gray = roiflow::eval::read_image("frames/0001.png", cv::IMREAD_GRAYSCALE);
-//   roiflow::eval::check_frame_size(gray.size(), "image 'frames/0001.png'");
-//   roiflow::eval::write_image_atomically("out/flow.png", gray);
+//   roiflow::eval::check_image_output("out/frame.png", "--color");  // before the long work
+//   roiflow::eval::write_image_atomically("out/frame.png", bgr);
+//   const cv::Mat gray = roiflow::eval::read_image("out/frame.png", cv::IMREAD_GRAYSCALE);
+//   roiflow::eval::check_frame_size(gray.size(), "image 'out/frame.png'");
+//   #include <opencv2/imgcodecs.hpp>
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -33,5 +36,7 @@ cv::Mat read_image(const std::string& path, int flags);
 // cv::imwrite to a partial file, then renamed over `path` (core/atomic_write.hpp); the format
 // follows the extension. Throws roiflow::Error "cannot write image '<path>'" on failure.
 void write_image_atomically(const std::string& path, const cv::Mat& image);
+// check_output_path, and UsageError when OpenCV cannot write an image named `path`.
+void check_image_output(const std::string& path, const std::string& option);
 
 }  // namespace roiflow::eval

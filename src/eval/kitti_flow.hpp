@@ -1,15 +1,12 @@
-// KITTI optical-flow ground truth: 16-bit PNG files (KITTI 2012 and 2015 flow_occ/flow_noc).
+// KITTI optical-flow ground truth (2012 and 2015, flow_occ/flow_noc): 16-bit PNGs whose pixels
+// hold R = u * 64 + 32768, G = v * 64 + 32768 and B = 1 where the flow is valid. Decoded flow is
+// CV_32FC2 with invalid pixels set to the Middlebury "unknown" value, so every function that
+// skips unknown flow (flow_errors, flow_to_color) skips them. Malformed input throws
+// roiflow::Error naming the file.
 //
-//   using namespace roiflow;
-//   cv::Mat truth = eval::read_kitti_flow("training/flow_occ/000042_10.png");
-//   flow::FlowErrors e = flow::flow_errors(estimate, truth);      // invalid pixels not scored
-//   eval::write_kitti_flow("out/000042_10.png", estimate);       // export for KITTI's devkit
-//
-// Each pixel holds three uint16: R = u * 64 + 32768, G = v * 64 + 32768, B = 1 where the flow
-// is valid and 0 where it is not. Decoded flow is CV_32FC2 with invalid pixels set to the
-// Middlebury "unknown" value (1e10, 1e10), so every roiflow function that skips unknown flow
-// (flow_errors, flow_to_color, endpoint_error_image) skips them too. OpenCV holds colour in
-// B, G, R order: R is channel 2. Malformed input throws roiflow::Error naming the file.
+//   const cv::Mat flow(frame_t.size(), CV_32FC2, cv::Scalar(2.f, 0.f));
+//   roiflow::eval::write_kitti_flow("000042_10.png", flow);  // for KITTI's devkit
+//   const cv::Mat truth = roiflow::eval::read_kitti_flow("000042_10.png");
 #pragma once
 
 #include <opencv2/core.hpp>

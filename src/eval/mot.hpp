@@ -4,7 +4,8 @@
 //   using namespace roiflow;
 //   const auto gt = eval::read_mot("PETS09-S2L1/gt/gt.txt", "ground truth");
 //   const auto pred = eval::read_mot("mot.txt", "tracker output");
-//   const eval::MotScore s = eval::score_mot(pred, gt);   // s.mota, s.idf1, s.id_switches...
+//   const eval::MotScore s = eval::score_mot(pred, gt);
+//   std::cout << s.mota << " " << s.idf1 << " " << s.id_switches << "\n";
 //   eval::write_mot("out/mot.txt", pred);                 // frame,id,x,y,w,h,conf,-1,-1,-1
 //
 // Files: one box per line, `frame,id,x,y,w,h[,conf[,...]]` (commas; a line without a comma

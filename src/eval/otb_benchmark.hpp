@@ -8,8 +8,9 @@
 //   run.boxes = {seqs[0].truth[0]};             // one box and one lost flag per frame
 //   run.lost = {false};
 //   run.cpu_s = 0.001;                          // CPU time of its calls
-//   std::vector<eval::BenchmarkRow> rows = {eval::score_run(seqs[0].name, "mine", seqs[0].truth,
-//   run)}; const std::vector<eval::BenchmarkRow> means = eval::tracker_means(rows, {"mine"});
+//   const std::vector<eval::BenchmarkRow> rows = {
+//       eval::score_run(seqs[0].name, "mine", seqs[0].truth, run)};
+//   const std::vector<eval::BenchmarkRow> means = eval::tracker_means(rows, {"mine"});
 //   std::cout << eval::format_benchmark_markdown(rows, means);
 //
 // A sequence is a folder holding `groundtruth_rect.txt` (OTB's x,y,w,h or TinyTLP's 6 columns,

@@ -260,4 +260,38 @@ OtbScore score(const std::vector<cv::Rect2f>& track, const std::vector<cv::Rect2
   return s;
 }
 
+std::vector<cv::Rect2f> read_track_boxes(const std::string& path) {
+  const std::vector<TrackRecord> records = read_track_csv(path);
+  try {
+    return track_boxes(records);
+  } catch (const Error& e) {
+    // track_boxes knows records, not the file they came from.
+    throw Error("track log '" + path + "': " + e.what());
+  }
+}
+
+std::string score_table(const OtbScore& s, std::size_t track_boxes, std::size_t truth_boxes) {
+  return "success AUC    " + fixed(s.auc, 4) + "\nprecision@20   " + fixed(s.precision20, 4) +
+         "\nmean IoU       " + fixed(s.mean_iou, 4) + "\nframes         " +
+         std::to_string(s.frames) + " (track " + std::to_string(track_boxes) + ", ground truth " +
+         std::to_string(truth_boxes) + ")\n";
+}
+
+cv::Rect2f parse_box(const std::string& text) {
+  std::string spaced = text;
+  std::replace(spaced.begin(), spaced.end(), ',', ' ');
+  std::istringstream in(spaced);
+  double v[4];
+  for (double& x : v) {
+    if (!(in >> x) || !std::isfinite(x)) throw Error("expected x,y,w,h, got '" + text + "'");
+  }
+  std::string rest;
+  if (in >> rest) throw Error("expected 4 numbers x,y,w,h, got '" + text + "'");
+  if (!(v[2] > 0 && v[3] > 0)) {
+    throw Error("the box needs a positive width and height, got '" + text + "'");
+  }
+  return {static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2]),
+          static_cast<float>(v[3])};
+}
+
 }  // namespace roiflow::eval

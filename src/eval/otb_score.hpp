@@ -1,32 +1,14 @@
-// OTB one-pass evaluation (OPE) of a track against ground-truth boxes.
+// OTB one-pass evaluation (OPE) of a track against ground-truth boxes, as the OTB benchmark's
+// MATLAB code computes it (success AUC over 21 IoU thresholds, precision@20 px, mean IoU), with
+// the departures docs/SCORING.md lists (absent-target frames left out, the shorter length
+// scored); the ground-truth reader, the track's boxes, the curves of the plots and the text
+// `roiflow score` prints.
 //
-//   using namespace roiflow;
-//   const auto truth = eval::read_ground_truth("Car4/groundtruth_rect.txt");
-//   const auto track = eval::track_boxes(eval::read_track_csv("car4.csv"));
-//   const eval::OtbScore s = eval::score(track, truth);   // s.auc, s.precision20, ...
-//
-// The metrics follow the OTB benchmark's MATLAB code (Wu, Lim, Yang, CVPR 2013 and TPAMI 2015;
-// calcSeqErrRobust.m, calcRectInt.m, perfPlot.m), which pysot and got10k reproduce:
-//  - IoU of the axis-aligned boxes. OTB's inclusive pixel bounds (right = x + w - 1, overlap
-//    width = min(right) - max(left) + 1) give exactly the continuous intersection used here.
-//  - Success AUC: the mean, over the 21 thresholds t = 0, 0.05, ..., 1, of the share of frames
-//    with IoU > t (strictly, as OTB's `errCoverage > thresholdSetOverlap`). No IoU exceeds 1,
-//    so a perfect track scores 20/21 = 0.952, as it does in OTB.
-//  - Precision@20: the share of frames whose centre error is <= 20 px (`errCenter <=`). OTB's
-//    centre x + (w - 1) / 2 and the x + w / 2 used here differ by the same 0.5 px for both
-//    boxes, so the distance is the same.
-//  - Mean IoU over the scored frames.
-// Where this departs from OTB's code, on purpose:
-//  - Ground-truth frames that mark the target absent (NaN, or a width or height that is not
-//    positive, e.g. an all-zero line) are left out of every metric and of `frames`. OTB instead
-//    counts them in the denominator as IoU -1 (a miss at every threshold) and centre error -1 (a
-//    hit at every threshold), and also treats a present target at x = 0 or y = 0 as absent.
-//  - The track's first box is scored as given. OTB overwrites it with the ground truth; a
-//    tracker started with `--init` from that box logs it anyway.
-//  - Frame i is compared with frame i over the shorter of the two lengths: a track cut short
-//    (`--max-frames`) scores its prefix; extra boxes on either side are ignored (OTB drops a
-//    longer result's tail too). `frames` says how many frames were scored; callers that want
-//    the full sequence compare it with the ground truth's length.
+//   const std::vector<cv::Rect2f> truth =
+//       roiflow::eval::parse_ground_truth("10,10,40,30\n12,11,40,30\n", "memory");
+//   const std::vector<cv::Rect2f> track = {{10, 10, 40, 30}, {13, 11, 40, 30}};
+//   const roiflow::eval::OtbScore s = roiflow::eval::score(track, truth);
+//   std::cout << roiflow::eval::score_table(s, track.size(), truth.size());  // AUC, precision...
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -57,14 +39,23 @@ std::vector<cv::Rect2f> read_ground_truth(const std::string& path);
 // The same from a file's text held in memory; `name` stands for the path in error messages.
 std::vector<cv::Rect2f> parse_ground_truth(std::string_view text, const std::string& name);
 
+// A box typed by a user, "x,y,w,h" (commas and/or spaces), with a finite positive size. Throws
+// roiflow::Error ("expected x,y,w,h, got '1,2,3'") otherwise.
+cv::Rect2f parse_box(const std::string& text);
+
 // The boxes of a track log, box i being frame i + 1. Throws roiflow::Error naming the record
 // when frames are not numbered 1, 2, 3, ... in order (the pairing with ground truth would be
 // wrong).
 std::vector<cv::Rect2f> track_boxes(const std::vector<TrackRecord>& records);
+// track_boxes of the track-log CSV at `path` (read_track_csv); errors name the file.
+std::vector<cv::Rect2f> read_track_boxes(const std::string& path);
 
 // Throws roiflow::Error, naming both lengths, when no frame is left to score.
 OtbScore score(const std::vector<cv::Rect2f>& track, const std::vector<cv::Rect2f>& truth);
 
+// What `roiflow score` prints: AUC, precision@20 and mean IoU to 4 decimals, and the frames
+// scored with both lengths (a shorter track, --max-frames, scores only its prefix).
+std::string score_table(const OtbScore& s, std::size_t track_boxes, std::size_t truth_boxes);
 // The curves of OTB's success and precision plots for one track, over the frames score()
 // scores: success[k] is the share of frames with IoU > k / 20 (k = 0..20; their mean is the AUC),
 // precision[t] the share with a centre error <= t px (t = 0..50; precision[20] is

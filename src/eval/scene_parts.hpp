@@ -1,7 +1,7 @@
 // The drawing parts the synthetic scenes share (tracking_scene.cpp defines them): seeded
 // streams, textured backgrounds, noise octaves and anti-aliased rounded-rectangle masks.
 //
-//   cv::RNG rng(roiflow::eval::detail::mix(seed, 0));
+//   cv::RNG rng(roiflow::eval::detail::mix(/*seed=*/1, 0));
 //   const cv::Mat background = roiflow::eval::detail::draw_background({640, 480}, rng);
 //   const cv::Mat alpha = roiflow::eval::detail::rounded_rect_alpha({72, 44}, 9.0);
 #pragma once

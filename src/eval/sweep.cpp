@@ -15,12 +15,6 @@ bool is_integer_param(SweepParam param) {
          param == SweepParam::Levels;
 }
 
-std::string fixed(double value, int decimals) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
-  return buffer;
-}
-
 std::vector<double> range(int first, int last) {
   std::vector<double> values;
   for (int v = first; v <= last; ++v)
@@ -166,6 +160,39 @@ std::string sweep_csv(const std::vector<SweepRow>& rows) {
   for (const SweepRow& r : rows) {
     out += std::string(to_string(r.param)) + ',' + sweep_value_text(r.value) + ',' +
            fixed(r.aae_deg, 3) + ',' + fixed(r.epe, 4) + ',' + fixed(r.ms_per_pair, 2) + '\n';
+  }
+  return out;
+}
+
+std::vector<std::pair<SweepParam, std::vector<double>>> sweep_plan(
+    const std::string& name, const std::vector<double>& values, const flow::LkParams& base) {
+  if (name == "all" && !values.empty()) throw UsageError("--values needs one --param, not all");
+  std::vector<std::pair<SweepParam, std::vector<double>>> plan;
+  for (SweepParam p : name == "all" ? all_sweep_params()
+                                    : std::vector<SweepParam>{sweep_param_from_string(name)}) {
+    plan.emplace_back(p, values.empty() ? default_sweep_values(p, base) : values);
+    for (double v : plan.back().second) {
+      try {
+        with_value(base, p, v);
+      } catch (const Error& e) {
+        throw UsageError(std::string("--values: ") + e.what());
+      }
+    }
+  }
+  return plan;
+}
+
+std::string sweep_progress_line(const SweepRow& r, std::size_t index, std::size_t count) {
+  return fmt::format("sweep {} {} ({}/{}): AAE {:.3f} deg, EPE {:.4f} px, {:.2f} ms/pair",
+                     to_string(r.param), sweep_value_text(r.value), index + 1, count, r.aae_deg,
+                     r.epe, r.ms_per_pair);
+}
+
+std::string sweep_table(const std::vector<SweepRow>& rows) {
+  std::string out = "parameter    value      AAE(deg)    EPE(px)  ms/pair\n";
+  for (const SweepRow& r : rows) {
+    out += fmt::format("{:<11} {:<9} {:>9.3f} {:>10.4f} {:>8.2f}\n", to_string(r.param),
+                       sweep_value_text(r.value), r.aae_deg, r.epe, r.ms_per_pair);
   }
   return out;
 }

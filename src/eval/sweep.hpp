@@ -1,20 +1,20 @@
-// Parameter sweeps of dense LK over pairs with ground truth (the paper's Fig. 7 and 8).
+// Parameter sweeps of dense LK over pairs with ground truth (the paper's Fig. 7 and 8): one
+// parameter varies, the others keep the base values; each value is evaluated on every pair
+// (evaluate_pair, dense LK timed alone, the fastest of `repeats` runs) and summarised as mean
+// AAE, mean EPE and mean milliseconds per pair. A value the parameter cannot take throws
+// roiflow::Error naming it.
 //
-//   using namespace roiflow;
-//   const auto pairs = eval::find_middlebury("data/middlebury");
-//   const auto rows = eval::sweep(pairs, flow::LkParams::paper(), eval::SweepParam::Patch,
-//                                   eval::default_sweep_values(eval::SweepParam::Patch, {}));
-//   write_text_atomically("out/sweep.csv", eval::sweep_csv(rows));
-//
-// One parameter varies at a time, the others keep the base parameters' values. Each value is
-// evaluated on every pair with evaluate_pair (dense_flow timed alone, file I/O excluded) and
-// summarised as the mean AAE, mean EPE and mean milliseconds per pair. A value the parameter
-// cannot take (patch 40, iterations 2.5, lambda 0) throws roiflow::Error naming it.
+//   const auto pairs = roiflow::eval::find_middlebury("data/middlebury");
+//   const auto plan = roiflow::eval::sweep_plan("patch", {5, 9, 13}, roiflow::flow::LkParams{});
+//   const auto rows = roiflow::eval::sweep(pairs, roiflow::flow::LkParams::paper(),
+//                                          plan[0].first, plan[0].second);
+//   std::cout << roiflow::eval::sweep_table(rows) << roiflow::eval::sweep_csv(rows);
 #pragma once
 
 #include <functional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "core/executor.hpp"
@@ -33,6 +33,12 @@ std::vector<SweepParam> all_sweep_params();  // in the order above
 // patch 3..31 (every size), iterations 1..10, levels 1..6; sigma 0..3 px and lambda
 // 1e-8..1e-2 (decades), each with the base value added when it is not in the list.
 std::vector<double> default_sweep_values(SweepParam param, const flow::LkParams& base);
+
+// The parameters `name` stands for ("all": every one) and each one's values: `values`, or its
+// default_sweep_values when empty, each checked with with_value. Throws UsageError ("--values:
+// ...") for a value a parameter cannot take, and for values given with "all".
+std::vector<std::pair<SweepParam, std::vector<double>>> sweep_plan(
+    const std::string& name, const std::vector<double>& values, const flow::LkParams& base);
 
 // `base` with `param` set to `value`; throws roiflow::Error ("patch 40: patch must be in
 // 3..31, got 40") when the result is invalid or an integer parameter gets a fraction.
@@ -65,4 +71,9 @@ std::vector<SweepRow> sweep(const std::vector<EvalPair>& pairs, const flow::LkPa
 std::string sweep_value_text(double value);
 // Header `parameter,value,aae_deg,epe,ms_per_pair`; aae 3 decimals, epe 4, ms 2.
 std::string sweep_csv(const std::vector<SweepRow>& rows);
+// "sweep patch 7 (3/29): AAE 4.123 deg, EPE 0.4123 px, 12.34 ms/pair" for value i of n.
+std::string sweep_progress_line(const SweepRow& row, std::size_t index, std::size_t count);
+// The table `roiflow sweep` prints: parameter, value, AAE, EPE, ms per pair.
+std::string sweep_table(const std::vector<SweepRow>& rows);
+
 }  // namespace roiflow::eval

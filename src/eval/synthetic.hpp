@@ -1,13 +1,14 @@
-// Synthetic image pairs with exact ground-truth flow, for tests, demos and benchmarks.
+// Synthetic image pairs with exact ground-truth flow, for tests, demos and benchmarks. Frames are
+// rendered from a band-limited continuous texture (random multi-scale sinusoids and soft blobs),
+// so sub-pixel motion is exact: frame1(x) = texture(W^-1(x)), and the ground truth is the forward
+// flow W(x) - x at every pixel of frame0 (CV_32FC2, u right, v down).
 //
-//   auto s = roiflow::eval::make_scene(SceneKind::Rotation, {320, 240}, /*seed=*/7);
-//   FlowResult r = dense_flow(s.frame0, s.frame1, LkParams::paper());
-//   FlowErrors e = flow_errors(r.flow, s.flow);
-//
-// Frames are rendered from a band-limited continuous texture (random multi-scale sinusoids
-// and soft blobs), so sub-pixel motion is exact, not an interpolation of a sampled image.
-// frame1(x) = texture(W^-1(x)); the ground truth is the forward flow W(x) - x at every pixel
-// of frame0 (CV_32FC2, u right, v down).
+//   #include "flow/dense_lk.hpp"
+//   #include "flow/metrics.hpp"
+//   const roiflow::eval::Scene s =
+//       roiflow::eval::make_scene(roiflow::eval::SceneKind::Rotation, {320, 240}, /*seed=*/7);
+//   const auto r = roiflow::flow::dense_flow(s.frame0, s.frame1, roiflow::flow::LkParams::paper());
+//   std::cout << roiflow::flow::flow_errors(r.flow, s.flow).epe << " px\n";
 #pragma once
 
 #include <cstdint>

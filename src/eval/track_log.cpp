@@ -2,7 +2,6 @@
 
 #include <charconv>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <string_view>
@@ -19,18 +18,17 @@ constexpr int kBoxDecimals = 2;
 constexpr int kVelocityDecimals = 3;
 constexpr int kMsDecimals = 3;
 
-// "-0.00" would read back as a distinct value in some tools and looks like a sign error.
-std::string fixed(double value, int decimals) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
-  std::string text = buffer;
+// Without the sign of a value that rounds to zero: "-0.00" would read back as a distinct value
+// in some tools and looks like a sign error.
+std::string log_fixed(double value, int decimals) {
+  std::string text = fixed(value, decimals);
   if (text.front() == '-' && text.find_first_not_of("-0.") == std::string::npos) text.erase(0, 1);
   return text;
 }
 
 // The JSON log carries exactly the values of the CSV log, so both score identically.
 double rounded(double value, int decimals) {
-  return std::stod(fixed(value, decimals));
+  return std::stod(log_fixed(value, decimals));
 }
 
 // --- reading ---------------------------------------------------------------------------------
@@ -130,11 +128,11 @@ void check_track_record(const TrackRecord& r, const std::string& path) {
 }
 
 std::string track_csv_row(const TrackRecord& r) {
-  return std::to_string(r.frame) + "," + fixed(r.box.x, kBoxDecimals) + "," +
-         fixed(r.box.y, kBoxDecimals) + "," + fixed(r.box.width, kBoxDecimals) + "," +
-         fixed(r.box.height, kBoxDecimals) + "," + fixed(r.velocity.x, kVelocityDecimals) + "," +
-         fixed(r.velocity.y, kVelocityDecimals) + "," + to_string(r.mode) + "," +
-         (r.lost ? "1" : "0") + "," + fixed(r.ms, kMsDecimals) + "\n";
+  return std::to_string(r.frame) + "," + log_fixed(r.box.x, kBoxDecimals) + "," +
+         log_fixed(r.box.y, kBoxDecimals) + "," + log_fixed(r.box.width, kBoxDecimals) + "," +
+         log_fixed(r.box.height, kBoxDecimals) + "," + log_fixed(r.velocity.x, kVelocityDecimals) +
+         "," + log_fixed(r.velocity.y, kVelocityDecimals) + "," + to_string(r.mode) + "," +
+         (r.lost ? "1" : "0") + "," + log_fixed(r.ms, kMsDecimals) + "\n";
 }
 
 std::string track_json_object(const TrackRecord& r) {

@@ -1,15 +1,13 @@
-// The track-log format: one record per frame of a tracking run, as CSV or JSON, and its reader.
+// The track-log format: one record per frame of a tracking run, as CSV (the header
+// `frame,x,y,w,h,vx,vy,mode,lost,ms`, box to 2 decimals, velocity and ms to 3) or as a JSON array
+// of objects with the same keys and rounding, one per line; and the strict CSV reader. The
+// writer that keeps a file valid while a run goes is stages::TrackLogWriter.
 //
-//   using namespace roiflow;
-//   const eval::TrackRecord r{.frame = 1, .box = {70, 51, 107, 87}};
-//   std::string csv = std::string(eval::kTrackCsvHeader) + "\n" + eval::track_csv_row(r);
-//   for (const eval::TrackRecord& back : eval::parse_track_csv(csv, "memory")) (void)back;
-//
-// CSV: the header `frame,x,y,w,h,vx,vy,mode,lost,ms`, then one line per record with the box to
-// 2 decimals, the velocity and ms to 3, mode `local` or `global`, lost `0` or `1`.
-// JSON: an array of objects with the same keys and the same rounding (lost is a boolean), one
-// record per line: `[\n{"frame":1,...},\n{"frame":2,...}\n]\n`. The writer that keeps such a
-// file valid while a run goes is stages::TrackLogWriter (stages/track_log_sink.hpp).
+//   roiflow::eval::TrackRecord r;
+//   r.box = {70, 51, 107, 87};  // frame 1
+//   const std::string csv =
+//       std::string(roiflow::eval::kTrackCsvHeader) + "\n" + roiflow::eval::track_csv_row(r);
+//   const auto records = roiflow::eval::parse_track_csv(csv, "memory");  // r, rounded
 #pragma once
 
 #include <opencv2/core.hpp>

@@ -1,23 +1,14 @@
-// TrackingScene: a synthetic fixed-camera video with an exact ground-truth box per frame.
+// A synthetic fixed-camera video with an exact ground-truth box per frame: a textured vehicle
+// crosses a textured background, speeding up and braking, growing or shrinking, and once, at
+// jump_frame(), jumps further than a 50x50 local region can follow, so a tracker must fall back
+// to a global search. Frames are rendered on demand and deterministically (noise included).
 //
-//   roiflow::eval::TrackingScene scene;                  // 640x480, 150 frames, seed 1
+//   const roiflow::eval::TrackingScene scene;  // 640x480, 150 frames
 //   for (int i = 0; i < scene.frames(); ++i) {
-//     cv::Mat frame = scene.render(i);                   // CV_8UC3 (BGR)
-//     cv::Rect2f truth = scene.box(i);                   // where the vehicle is
+//     const cv::Mat frame = scene.render(i);   // CV_8UC3 (BGR)
+//     const cv::Rect2f truth = scene.box(i);   // where the vehicle is
+//     if (i == scene.jump_frame()) std::cout << truth << "\n";
 //   }
-//   int j = scene.jump_frame();                          // box(j) is far from box(j - 1)
-//
-// A textured "vehicle" (a rounded rectangle, saturated body colour, its own fine texture, dark
-// windows) crosses a static textured background (multi-scale smoothed noise in muted colours
-// plus a few soft shapes) from left to right. Its speed varies smoothly — it accelerates and
-// brakes — and once, at jump_frame(), it moves `jump` pixels in one frame: more than a 50x50
-// local region can follow, so a tracker has to fall back to a global search there. Its size
-// changes linearly by `scale_change` over the run, and it drifts gently up and down. The path
-// is scaled so that the whole vehicle stays inside the frame on every frame.
-//
-// The vehicle is drawn with a sub-pixel affine warp and an anti-aliased mask, so box(i) is the
-// exact extent of the drawn shape. Frames are rendered on demand, deterministically: the same
-// params give the same frames, camera noise included.
 #pragma once
 
 #include <cstdint>

@@ -1,21 +1,15 @@
-// Middlebury colour coding of flow (Baker et al. 2011; the paper's Fig. 10).
+// Middlebury colour coding of flow (Baker et al. 2011; the paper's Fig. 10): hue gives the
+// direction (the 55-colour Middlebury wheel), saturation the magnitude relative to
+// `max_magnitude` (<= 0: the field's robust maximum, a high percentile of its magnitudes, so
+// that a few wild vectors do not wash the picture out; beyond it hues darken); unknown pixels
+// are black. To compare an estimate with its ground truth, colour both with the truth's
+// max_magnitude(). Also the wheel as a legend and arrows drawn over an image.
 //
-//   cv::Mat bgr = roiflow::flow::flow_to_color(flow);        // CV_8UC3, for cv::imwrite
-//   cv::Mat key = roiflow::flow::color_wheel_legend(151);    // the wheel, as a legend
-//
-// Hue gives the direction (the 55-colour Middlebury wheel: RY 15, YG 6, GC 4, CB 11, BM 13,
-// MR 6), saturation the magnitude relative to `max_magnitude` (<= 0: the field's robust
-// maximum, robust_max_magnitude). Magnitudes beyond it keep their hue, darkened (Middlebury's
-// rule). Unknown pixels (|u| or |v| > 1e9, NaN) are black.
-//
-// The robust maximum is a high percentile of the known magnitudes rather than their maximum,
-// so that a few wild vectors (border outliers of an estimate, a handful of pixels) do not
-// wash the whole picture out; on a field with fewer than 1 / (1 - percentile) pixels it is the
-// maximum. To compare an estimate with its ground truth, colour both with the truth's
-// max_magnitude().
-//
-//   const float scale = roiflow::flow::max_magnitude(truth);
-//   cv::Mat a = roiflow::flow::flow_to_color(estimate, scale), b = flow_to_color(truth, scale);
+//   const cv::Mat flow(frame_t.size(), CV_32FC2, cv::Scalar(1.5f, -0.5f));
+//   const cv::Mat coded = roiflow::flow::flow_to_color(flow);     // CV_8UC3, for cv::imwrite
+//   const cv::Mat scaled = roiflow::flow::flow_to_color(flow, roiflow::flow::max_magnitude(flow));
+//   const cv::Mat legend = roiflow::flow::color_wheel_legend(151);
+//   const cv::Mat arrows = roiflow::flow::draw_flow_vectors(bgr, flow, 16);
 #pragma once
 
 #include <opencv2/core.hpp>

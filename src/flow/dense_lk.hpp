@@ -1,24 +1,18 @@
-// Dense iterative pyramidal Lucas–Kanade optical flow (the paper's Algorithm 1).
+// Dense iterative pyramidal Lucas-Kanade optical flow (the paper's Algorithm 1). For each
+// pyramid level from coarse to fine, the coarser flow is upsampled, frame t+1 is warped towards
+// frame t, and `iterations` times every pixel solves the Tikhonov-regularised 2x2 least-squares
+// system of its patch, (G + lambda I) w = b + lambda w_prev, from running window sums (O(1) per
+// pixel whatever the patch). DenseLK owns its workspace (freed with it, or by collectGarbage);
+// createDenseLK is the same as a cv::DenseOpticalFlow, a drop-in for cv::DISOpticalFlow; the
+// execution policy (an Executor) is separate from the options (LkParams). docs/ARCHITECTURE.md
+// describes the patch geometry and the large-displacement steps.
 //
-//   using namespace roiflow::flow;
-//   DenseLK lk(LkParams::paper());           // owns its buffers; reuse it for every pair
-//   FlowResult r = lk.calc(frame_t, frame_t1);
-//   cv::Mat flow = r.flow;                   // CV_32FC2: (u, v) in pixels, u right, v down
-//   cv::Ptr<cv::DenseOpticalFlow> of = createDenseLK();   // drop-in for cv::DISOpticalFlow
-//
-// For each pyramid level from coarse to fine: the flow of the coarser level is upsampled x2
-// (bilinear), frame t+1 is warped towards frame t with sub-pixel bilinear interpolation, and
-// `iterations` times every pixel solves the Tikhonov-regularised 2x2 least-squares system of
-// its patch:  (G + lambda I) w = b + lambda w_prev, G and b being window means of the
-// derivative products, linearised around each pixel's own current flow. Window sums come
-// from running sums, so one iteration costs O(1) per pixel whatever the patch size.
-//
-// Patch centring: a patch of n pixels always has total weight n and is centred on the pixel.
-// Derivatives live on the pixel grid (Scharr, central) or between pixels (Horn–Schunck's 2x2x2
-// cube, centred at x + 1/2). A window whose ends would fall half a pixel outside the grid
-// gets its two outermost rows/columns at weight 1/2 (n + 1 taps). So 10x10 with Horn–Schunck
-// derivatives is exactly the 10 half-pixel positions x-4.5 .. x+4.5, and 10x10 with Scharr
-// is 11 taps with half-weight ends: no half-pixel shift in either case.
+//   roiflow::flow::DenseLK lk(roiflow::flow::LkParams::paper());  // reuse it for every pair
+//   const roiflow::flow::FlowResult r = lk.calc(frame_t, frame_t1);
+//   const cv::Mat flow = r.flow;  // CV_32FC2: (u, v) in pixels, u right, v down
+//   cv::Ptr<cv::DenseOpticalFlow> of = roiflow::flow::createDenseLK();
+//   cv::Mat same;
+//   of->calc(frame_t, frame_t1, same);
 #pragma once
 
 #include <cstddef>

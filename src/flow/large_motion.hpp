@@ -1,28 +1,19 @@
-// Large displacements for dense LK: how many pyramid levels a frame gets, a coarse search that
-// starts the coarsest level inside LK's basin when objects move further than a patch, and a
-// candidate fusion that carries a motion found in one part of an object over to the rest.
+// Large displacements for dense LK: how many pyramid levels a frame gets (auto_levels), a coarse
+// search that starts the coarsest level inside LK's basin when objects move further than a
+// patch (search_flow: zero-mean SSD over a window, forward-backward consistent, better than the
+// prior by a margin; unreliable pixels take the better of the prior and their nearest reliable
+// neighbour's flow), and a candidate fusion that carries a motion found in one part of an object
+// over to the rest (fuse_candidates). They work on CV_32FC1 level images in [0, 1] and planar
+// flow (u, v) in level pixels.
 //
 //   using namespace roiflow::flow;
-//   const int levels = auto_levels({1242, 375}, /*expected_motion=*/0.0);      // 4 levels
+//   const int levels = auto_levels({1242, 375}, /*expected_motion=*/0.0);
+//   const Pyramid p0 = build_pyramid(frame_t, levels, 0.5);
+//   const Pyramid p1 = build_pyramid(frame_t1, levels, 0.5);
+//   const cv::Mat &i0 = p0.levels.back(), &i1 = p1.levels.back();
 //   cv::Mat u(i0.size(), CV_32F, 0.f), v(i0.size(), CV_32F, 0.f);
-//   search_flow(i0, i1, {0.f, 0.f}, SearchParams{.radius = 12}, u, v);         // coarsest level
-//   fuse_candidates(i0, i1, /*step=*/6, /*window=*/7, u, v);                   // any level
-//
-// LK linearises the brightness equation, so it converges only when its starting flow is off by
-// less than about a window's reach at the level it starts on: pyramid levels alone reach a
-// motion of a few pixels times 2^levels, but the coarsest levels of a small frame are a few
-// dozen pixels wide and a patch there covers whole objects. The coarse search instead matches
-// every pixel of a level that keeps object detail (shorter side >= 40 px) over a range of
-// displacements, and keeps a match only when it is reliable:
-// - zero-mean SSD over a window (DIS's mean normalisation: a brightness change between the
-//   frames, as KITTI's exposure or Sintel's fog, does not move the minimum);
-// - forward-backward consistency: searching frame t+1 in frame t must lead back to the pixel
-//   (within `fb_tolerance`), which rejects occluded pixels and repeated texture;
-// - it must beat the prior (the motion assumed before the search) by `prior_margin` of the
-//   prior's cost, which rejects matches in flat areas where any displacement fits.
-// An unreliable pixel takes, of the prior and the flow of its nearest reliable pixel, the one
-// whose window matches better (the prior on a tie). All functions work on CV_32FC1 level images
-// in [0, 1] and planar flow (u, v) in level pixels.
+//   search_flow(i0, i1, {0.f, 0.f}, SearchParams{}, u, v);  // the coarsest level
+//   fuse_candidates(i0, i1, /*step=*/6, /*window=*/7, u, v);  // any level
 #pragma once
 
 #include <opencv2/core.hpp>

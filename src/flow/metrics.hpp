@@ -1,13 +1,13 @@
-// Flow error metrics against ground truth (Baker et al., IJCV 2011).
+// Flow error metrics against ground truth (Baker et al., IJCV 2011), over the known ground-truth
+// pixels (|u| or |v| > 1e9, or NaN, is unknown) outside the non-zero pixels of an optional
+// exclude mask: EPE = |(u, v) - (ug, vg)|; AE = the angle between (u, v, 1) and (ug, vg, 1) in
+// degrees; R1, R3 = the percentage of pixels with EPE > 1 and > 3; Fl = the percentage with EPE >
+// 3 and > 5 % of |(ug, vg)| (KITTI's outlier rate).
 //
-//   FlowErrors e = roiflow::flow::flow_errors(estimate, ground_truth);
-//   std::printf("AAE %.2f deg, EPE %.3f px\n", e.aae_deg, e.epe);
-//
-// Over known ground-truth pixels only (|u| or |v| > 1e9, or NaN, is unknown) and, when
-// `exclude` is given (CV_8UC1, same size), outside its non-zero pixels.
-//   EPE = |(u, v) - (ug, vg)|;  AE = angle between (u, v, 1) and (ug, vg, 1) in degrees;
-//   R1, R3 = percentage of pixels with EPE > 1 and > 3;
-//   Fl = percentage of pixels with EPE > 3 and EPE > 5 % of |(ug, vg)| (KITTI's outlier rate).
+//   const cv::Mat truth(frame_t.size(), CV_32FC2, cv::Scalar(1.f, 0.f));
+//   const cv::Mat estimate(frame_t.size(), CV_32FC2, cv::Scalar(1.1f, 0.f));
+//   const roiflow::flow::FlowErrors e = roiflow::flow::flow_errors(estimate, truth);
+//   std::cout << "AAE " << e.aae_deg << " deg, EPE " << e.epe << " px\n";  // EPE 0.1
 #pragma once
 
 #include <opencv2/core.hpp>

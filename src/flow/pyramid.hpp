@@ -1,15 +1,13 @@
-// Gaussian image pyramid, the pretreatment and the multi-scale support of dense LK: the one
-// builder of every pyramid in roiflow (whole frames, parts of frames, level by level).
+// Gaussian image pyramids, the one builder for every caller (whole frames, parts of frames,
+// level by level). Level 0 is the input as float in [0, 1], smoothed by a Gaussian of `sigma`
+// pixels (0 = none; the paper's pretreatment otherwise); level k+1 is level k smoothed by
+// [1 4 6 4 1]/16 and halved (cv::pyrDown's values). An image too small for the levels asked
+// gets fewer: the coarsest level keeps at least kMinLevelSide pixels on its shorter side.
 //
-//   auto pyr = roiflow::flow::build_pyramid(gray8, /*levels=*/3, /*sigma=*/1.0);
-//   const cv::Mat& coarsest = pyr.levels.back();    // CV_32FC1, intensities in [0, 1]
-//
-// Level 0 is the input converted to float in [0, 1] and smoothed by a Gaussian of `sigma`
-// pixels (0 = no smoothing, the paper's pretreatment otherwise). Level k+1 is level k
-// smoothed by the 5-tap Gaussian [1 4 6 4 1]/16 and decimated by 2 (cv::pyrDown's values,
-// size (w+1)/2 x (h+1)/2, so pixel x of level k+1 sits at 2x of level k). An image too small
-// for the levels asked gets fewer levels: the coarsest level keeps at least `kMinLevelSide`
-// pixels on its shorter side.
+//   const roiflow::flow::Pyramid pyr = roiflow::flow::build_pyramid(frame_t, 3, 1.0);
+//   std::cout << pyr.levels.back().size() << "\n";  // the coarsest: CV_32FC1, values in [0, 1]
+//   roiflow::flow::Pyramid part;                   // the levels of a region only
+//   roiflow::flow::build_pyramid_part(frame_t, {8, 8, 64, 64}, 3, 1.0, part);
 #pragma once
 
 #include <opencv2/core.hpp>

@@ -1,30 +1,14 @@
 // One-pass evaluation (OPE) of several single-object trackers over every sequence of an
-// OTB-layout folder: `roiflow benchmark`'s run.
+// OTB-layout folder, `roiflow benchmark`'s run: every tracker starts from each sequence's first
+// ground-truth box and sees every frame once, each sequence decoded once, sequences in
+// parallel, each tracker call timed on its thread's CPU clock (docs/BENCHMARK.md).
 //
-//   using namespace roiflow;
-//   pipeline::BenchmarkOptions options;
-//   options.dir = "data/tracking";                        // <seq>/img/*.jpg + groundtruth_rect.txt
+//   roiflow::pipeline::BenchmarkOptions options;
+//   options.dir = "data/tracking";  // <seq>/img/*.jpg + groundtruth_rect.txt
 //   options.trackers = {"roiflow", "csrt"};
-//   options.threads = 2;                                  // sequences at once
-//   const pipeline::BenchmarkResult result = pipeline::run_benchmark(options);
-//   pipeline::write_benchmark(result, "out/bench");       // benchmark.md/.csv,
-//   success/precision.svg
-//
-// Every tracker starts from the first ground-truth box of each sequence and then sees every
-// frame once (OTB's OPE; stages/box_tracker.hpp runs each). Each sequence is decoded once and
-// every tracker is given each frame in turn, so all see the same frames under the same load.
-// Sequences run in parallel on a oneTBB arena of `threads` threads; inside a sequence the work is
-// serial: roiflow's tracker gets no executor and OpenCV is held at one thread for the run. Each
-// tracker call is timed with the calling thread's CPU clock (CLOCK_THREAD_CPUTIME_ID), so frames/s
-// is single-threaded tracker time, decoding and colour conversion excluded, and is the same
-// whether sequences run in parallel or one after the other (up to cache and memory contention,
-// which every tracker of a sequence shares).
-//
-// Everything is checked before any tracker runs: the trackers' names (known, not repeated), the
-// folder and its sequences (ground truth readable, its first box present and inside the first
-// frame, one box per frame), `sequences` (each must exist). A frame that cannot be decoded
-// mid-run fails the run. All failures throw roiflow::Error with one line naming the cause.
-// write_benchmark() writes only after the whole run succeeded, each file atomically.
+//   options.threads = 2;  // sequences at once
+//   const roiflow::pipeline::BenchmarkResult result = roiflow::pipeline::run_benchmark(options);
+//   roiflow::pipeline::write_benchmark(result, "out/bench");  // benchmark.md/.csv, plots
 #pragma once
 
 #include <functional>

@@ -8,8 +8,9 @@
 //   out.video = "run/colour/";                        // PNG folder (or "run/flow.mp4")
 //   out.flow_dir = "run/flow";                        // run/flow/000001.png, ...
 //   out.flow_format = stages::FlowFileFormat::Kitti;
+//   stages::VideoSource source("synthetic:10");
 //   pipeline::DenseOutputs outputs(out, source.fps(), source.size());
-//   pipeline::run_dense([&] { return source.next(); }, params, outputs.sinks(), options);
+//   pipeline::run_dense([&] { return source.next(); }, flow::LkParams::paper(), outputs.sinks());
 //   outputs.close();
 //
 // Colour scale: `max_motion` pixels saturate when it is > 0; otherwise each pair's robust

@@ -1,43 +1,23 @@
-// The oneTBB flow graphs that run roiflow over a video: tracking mode and dense mode.
+// The oneTBB flow graphs that run roiflow over a video. Tracking mode: decoding and pyramids of
+// later frames run ahead of the serial tracker, bounded by a limiter (at most `max_in_flight`
+// frames alive), and every sink sees every frame once, in order. Dense mode: each frame is
+// paired with the previous one, several pairs' flow and the sinks' parallel parts
+// (FlowSink::prepare) run at once, and the sinks' ordered parts see the pairs in order.
+// An exception anywhere cancels the graph and is rethrown once the running nodes are done; a
+// cancel flag stops the source and finishes the frames in flight. docs/ARCHITECTURE.md, "The
+// graphs", draws them.
 //
-//   using namespace roiflow;
-//   stages::VideoSource source("car.mp4");
-//   pipeline::TbbExecutor tiles;                       // LK over row tiles of the region
-//   stages::Tracker tracker(params, &tiles);
-//   stages::TrackLogWriter log("track.csv");
-//   pipeline::GraphOptions options;
+//   roiflow::stages::VideoSource source("car.mp4");
+//   roiflow::pipeline::TbbExecutor tiles;  // LK over row tiles of the region
+//   roiflow::stages::Tracker tracker(roiflow::stages::TrackerParams{}, &tiles);
+//   roiflow::pipeline::GraphOptions options;
 //   options.threads = 4;
-//   pipeline::RunReport report = pipeline::run_tracking(
+//   const roiflow::pipeline::RunReport report = roiflow::pipeline::run_tracking(
 //       [&] { return source.next(); }, tracker,
-//       {{"log", [&](const pipeline::TrackedFrame& f) { log.write(f.output->record()); }}},
+//       {{"print", [](const roiflow::pipeline::TrackedFrame& f) { std::cout << f.seq << "\n"; }}},
 //       options);
-//
-// Tracking mode (DESIGN.md, "Data flow"):
-//   source ─► limiter ─► pyramid level 0 ─► level 1 ─► … ─► sequencer ─► tracker (serial)
-//                                                                           │
-//                        limiter ◄─ retire ◄─ sinks (one serial node each) ◄─┘ sequencer,
-//                                                                              broadcast
-// Decoding and the pyramids of later frames run ahead of the tracker (different frames and
-// different levels of different frames at once), bounded by the limiter: at most
-// `max_in_flight` frames exist between the source and their retirement, whatever the length of
-// the stream. Whole-frame pyramids are built only while the tracker wants them (global mode,
-// target not yet known); otherwise the local treatment builds pyramids of its region itself,
-// a fraction of a whole one. The tracker is the serial critical path (its region for frame t+1
-// comes from its decision at t); it parallelises inside through the TbbExecutor it was given (row
-// tiles of the region). Every sink sees every frame exactly once, in order (the second sequencer:
-// oneTBB does not keep the order between two serial nodes); a frame is retired when all sinks are
-// done with it.
-//
-// Dense mode: the same front end, then a serial node that pairs each frame with the previous
-// one (each pyramid serves two pairs, built once), a flow node that runs several pairs at once
-// (one thread each: more pairs are in flight than threads, and row tiles on top cost
-// throughput), a prepare node that runs the sinks' parallel parts (FlowSink::prepare, several
-// pairs at once), a sequencer that restores pair order, and the sinks' ordered parts.
-//
-// Errors: an exception in the source, a stage or a sink cancels the graph; the run function
-// waits for the nodes already running, then rethrows it (so the caller reports it; sinks keep
-// what they have written). Cancellation: when `*options.cancel` becomes true the source stops
-// reading, the frames already in flight are finished, and the report says cancelled.
+//   std::cout << report.frames << " frames in " << report.wall_s << " s\n";
+//   #include "pipeline/tbb_executor.hpp"
 #pragma once
 
 #include <atomic>

@@ -1,13 +1,14 @@
 // Thread scaling: the same run over the same input at several thread counts, and how its
 // throughput grows (speedup and parallel efficiency), as a table and an SVG plot.
 //
+//   #include "core/atomic_write.hpp"
 //   using namespace roiflow;
 //   pipeline::ScalingOptions o;
 //   o.input = "synthetic:300:640x480:16";
 //   o.threads = {1, 2, 4};
 //   o.mode = pipeline::ScalingMode::Local;
 //   const pipeline::ScalingResult r = pipeline::run_scaling(o);
-//   write_text_atomically("out/scaling.csv", pipeline::scaling_csv(r));
+//   roiflow::write_text_atomically("out/scaling.csv", pipeline::scaling_csv(r));
 //   report::write_plot_svg("out/scaling.svg", pipeline::scaling_plot(r));
 //
 // Each thread count gets its own runs: a fresh VideoSource, a fresh tracker, one oneTBB arena

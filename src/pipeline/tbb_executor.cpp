@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <opencv2/core/utility.hpp>
 #include <string>
+#include <thread>
 
 #include "core/error.hpp"
 
@@ -85,6 +86,10 @@ ThreadScope::ThreadScope(int threads)
 
 ThreadScope::~ThreadScope() {
   cv::setNumThreads(previous_cv_threads_);
+}
+
+int default_threads() {
+  return std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, kMaxThreads);
 }
 
 }  // namespace roiflow::pipeline

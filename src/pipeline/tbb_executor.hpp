@@ -1,15 +1,12 @@
-// TbbExecutor — the flow core's row stripes on oneTBB, and a scope that fixes the thread count.
+// The flow core's row stripes on oneTBB, and a scope that fixes the thread count. TbbExecutor
+// runs in whatever task_arena its caller is in (it owns no threads; one instance serves every
+// caller); run_with_threads(n, f) runs f in a fresh arena of n threads and pins OpenCV's own
+// thread count to n for the call, so that "one thread" means one.
 //
-//   using namespace roiflow;
-//   pipeline::TbbExecutor tbb_exec;
-//   flow::DenseLK lk(flow::LkParams::paper(), &tbb_exec);
-//   auto r = pipeline::run_with_threads(2, [&] { return lk.calc(frame_t, frame_t1); });
-//
-// TbbExecutor::for_range runs in whatever task_arena its caller is in, so it owns no threads and
-// one instance can serve every caller. run_with_threads(n, f) runs f in a fresh arena of n
-// threads and, for the duration of the call, sets OpenCV's own thread count to n as well: the
-// pyramid, warps and filters OpenCV runs for us parallelise on their own, so "one thread" is
-// only true when both are pinned.
+//   const roiflow::pipeline::TbbExecutor tbb_exec;
+//   roiflow::flow::DenseLK lk(roiflow::flow::LkParams::paper(), &tbb_exec);
+//   const auto r = roiflow::pipeline::run_with_threads(2, [&] { return lk.calc(bgr, bgr); });
+//   std::cout << r.flow.size() << " on " << roiflow::pipeline::default_threads() << " threads\n";
 #pragma once
 
 #include <oneapi/tbb/task_arena.h>
@@ -22,6 +19,7 @@
 namespace roiflow::pipeline {
 
 inline constexpr int kMaxThreads = 256;
+int default_threads();  // the hardware's thread count, within 1..kMaxThreads
 
 class TbbExecutor final : public Executor {
  public:

@@ -1,28 +1,14 @@
-// The tracker's annotated video frame: what the tracker saw and decided, drawn on the input.
+// The tracker's annotated video frame: what it saw and decided, drawn on a BGR copy of the
+// input: the colour-coded flow of the local region, the region's outline, the target's box
+// (solid by the mode that produced it, dashed when lost), its velocity and a status line.
+// The annotation is a plain record, so drawing needs no tracker (docs/REPORTS.md has the
+// details).
 //
-//   roiflow::report::TrackAnnotation a;                 // what the tracker decided for a frame
+//   roiflow::report::TrackAnnotation a;  // what the tracker decided for a frame
 //   a.has_target = true;
 //   a.box = {70, 51, 107, 87};
 //   a.velocity = {2.f, 0.f};
-//   cv::Mat bgr = roiflow::report::annotate_frame(cv::Mat(240, 320, CV_8UC1, 128), a);
-//
-// The annotation is a plain record, so that drawing needs no tracker: the pipeline fills it
-// from a stages::TrackerOutput. Drawn on a BGR copy of `image` (8-bit gray or BGR), in this
-// order:
-//  - the colour-coded flow (Middlebury, flow::flow_to_color) blended over the image inside
-//    `out.region`, when `out.region_flow` holds the flow of that region;
-//  - the region's outline;
-//  - the target's box when there is one: solid in `local_color` or `global_color` by the mode
-//    that produced it, dashed in `lost_color` when the target is lost (the box is then only
-//    the prediction), and an arrow from its centre showing the velocity, `arrow_scale` times
-//    longer than one frame's motion (a few pixels per frame would otherwise be invisible);
-//  - a text line in the top-left corner: "frame N  local|global", followed by "  lost" or
-//    "  no target" where that applies. N is 1-based (index + 1), like the track log's frames,
-//    so an annotated frame can be looked up in the log.
-// Boxes and regions partly or wholly outside the frame are clipped; nothing outside is drawn.
-// Lines are drawn without anti-aliasing, so the style's colours appear exactly in the result.
-// Throws roiflow::Error for an image that is not 8-bit gray or BGR, a region_flow that is not
-// CV_32FC2 of the region's size, or a bad style.
+//   const cv::Mat drawn = roiflow::report::annotate_frame(frame_t, a);  // CV_8UC3
 #pragma once
 
 #include <opencv2/core.hpp>

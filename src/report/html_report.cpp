@@ -67,12 +67,6 @@ cv::Mat fit_width(const cv::Mat& image, int width) {
   return small;
 }
 
-std::string fixed(double value, int decimals) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
-  return buffer;
-}
-
 // Largest known magnitude of `flow` (0 when none is known).
 double max_magnitude(const cv::Mat& flow) {
   double max = 0;

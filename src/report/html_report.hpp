@@ -1,20 +1,15 @@
-// A self-contained HTML report of a flow evaluation: one file, images embedded, for a browser.
+// A self-contained HTML report of a flow evaluation, one file with its images embedded: the LK
+// parameters, a summary table and the colour-wheel legend, then per pair the frames, the true
+// and estimated flow colour-coded alike, the endpoint-error map and the metrics
+// (docs/REPORTS.md).
 //
-//   using namespace roiflow;
-//   report::HtmlReport report("roiflow eval data/middlebury", "paper", params);
-//   for (const eval::EvalPair& pair : pairs) {
-//     eval::EvalImages images;
-//     const eval::EvalRow row = eval::evaluate_pair(pair, params, nullptr, &images);
-//     report.add(row, images);      // encodes the images now; keeps only the compressed bytes
+//   const roiflow::flow::LkParams params = roiflow::flow::LkParams::paper();
+//   roiflow::report::HtmlReport report("roiflow eval data/middlebury", "paper", params);
+//   for (const auto& pair : roiflow::eval::find_middlebury("data/middlebury")) {
+//     roiflow::eval::EvalImages images;
+//     report.add(roiflow::eval::evaluate_pair(pair, params, nullptr, &images), images);
 //   }
-//   report.write("report.html");   // atomically
-//
-// At the top: the LK parameters, a summary table (one row per pair, linked to its section, and
-// the mean) and the colour-wheel legend. Per pair: frame t, frame t+1, the ground-truth and the
-// estimated flow colour-coded with the same maximum magnitude (the ground truth's), the
-// endpoint-error heat map with its colour bar and scale (grey: pixels not scored), and the
-// metrics over all and over non-occluded pixels. Images wider than `display_width` are
-// downscaled and embedded as base64 JPEG data URIs (about 0.2 MB a pair at 480 px).
+//   report.write("report.html");  // atomically
 #pragma once
 
 #include <cstddef>

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 
 #include "core/atomic_write.hpp"
@@ -153,6 +154,71 @@ Ticks nice_ticks(double lo, double hi, int target) {
   return t;
 }
 
+namespace {
+
+// The legend of `panel`: rows of items wrapped between `left` and `right`, the first row's
+// baseline at `ly`, which is left at the last row's.
+std::string legend_svg(const PlotPanel& panel, double left, double right, double& ly) {
+  std::string body;
+  double lx = left;
+  for (std::size_t i = 0; i < panel.series.size(); ++i) {
+    const PlotSeries& s = panel.series[i];
+    const double item_w = 34 + kCharWidth * static_cast<double>(s.name.size()) + 18;
+    if (lx > left && lx + item_w > right) {
+      lx = left;
+      ly += 18;
+    }
+    const char* color = kColors[i % kColorCount];
+    const std::string dash =
+        s.axis == PlotAxis::Right ? " stroke-dasharray=\"6 3\"" : std::string();
+    body += "<g class=\"legend\"><line x1=\"" + num(lx) + "\" y1=\"" + num(ly - 4) + "\" x2=\"" +
+            num(lx + 24) + "\" y2=\"" + num(ly - 4) + "\" stroke=\"" + color +
+            "\" stroke-width=\"2\"" + dash + "/><circle cx=\"" + num(lx + 12) + "\" cy=\"" +
+            num(ly - 4) + "\" r=\"3\" fill=\"" + color + "\"/><text x=\"" + num(lx + 30) +
+            "\" y=\"" + num(ly) + "\" font-size=\"12\">" + escape_markup(s.name) + "</text></g>\n";
+    lx += item_w;
+  }
+  return body;
+}
+
+// The series of `panel`: polylines broken at undrawable points, then the markers on top. `px`
+// maps x to pixels, `py(axis, y)` y on the left (0) or right (1) axis.
+std::string series_svg(const PlotPanel& panel, bool x_log, const std::function<double(double)>& px,
+                       const std::function<double(int, double)>& py) {
+  std::string body;
+  for (std::size_t i = 0; i < panel.series.size(); ++i) {
+    const PlotSeries& s = panel.series[i];
+    const int axis = s.axis == PlotAxis::Right ? 1 : 0;
+    const char* color = kColors[i % kColorCount];
+    std::string d;
+    std::string markers;
+    bool pen_down = false;
+    for (std::size_t k = 0; k < s.x.size(); ++k) {
+      if (!drawable(s.x[k], s.y[k], x_log)) {
+        pen_down = false;
+        continue;
+      }
+      const double cx = px(s.x[k]);
+      const double cy = py(axis, s.y[k]);
+      d += (pen_down ? " L" : (d.empty() ? "M" : " M")) + num(cx) + " " + num(cy);
+      pen_down = true;
+      if (s.markers) {
+        markers += "<circle class=\"marker\" cx=\"" + num(cx) + "\" cy=\"" + num(cy) +
+                   "\" r=\"3\" fill=\"" + color + "\"/>\n";
+      }
+    }
+    body += "<g class=\"series\">\n";
+    if (!d.empty()) {
+      body += "<path d=\"" + d + "\" fill=\"none\" stroke=\"" + color + "\" stroke-width=\"1.8\"" +
+              (s.axis == PlotAxis::Right ? " stroke-dasharray=\"6 3\"" : "") + "/>\n";
+    }
+    body += markers + "</g>\n";
+  }
+  return body;
+}
+
+}  // namespace
+
 std::string plot_svg(const Plot& plot) {
   check_plot(plot);
 
@@ -187,26 +253,8 @@ std::string plot_svg(const Plot& plot) {
     const bool last = p + 1 == plot.panels.size();
 
     // Legend rows, wrapped at the plot's width.
-    double lx = left;
     double ly = y + 12;
-    for (std::size_t i = 0; i < panel.series.size(); ++i) {
-      const PlotSeries& s = panel.series[i];
-      const double item_w = 34 + kCharWidth * static_cast<double>(s.name.size()) + 18;
-      if (lx > left && lx + item_w > right) {
-        lx = left;
-        ly += 18;
-      }
-      const char* color = kColors[i % kColorCount];
-      const std::string dash =
-          s.axis == PlotAxis::Right ? " stroke-dasharray=\"6 3\"" : std::string();
-      body += "<g class=\"legend\"><line x1=\"" + num(lx) + "\" y1=\"" + num(ly - 4) + "\" x2=\"" +
-              num(lx + 24) + "\" y2=\"" + num(ly - 4) + "\" stroke=\"" + color +
-              "\" stroke-width=\"2\"" + dash + "/><circle cx=\"" + num(lx + 12) + "\" cy=\"" +
-              num(ly - 4) + "\" r=\"3\" fill=\"" + color + "\"/><text x=\"" + num(lx + 30) +
-              "\" y=\"" + num(ly) + "\" font-size=\"12\">" + escape_markup(s.name) +
-              "</text></g>\n";
-      lx += item_w;
-    }
+    body += legend_svg(panel, left, right, ly);
     const double top = ly + 12;
     const double bottom = top + plot.panel_height;
 
@@ -269,37 +317,7 @@ std::string plot_svg(const Plot& plot) {
               num(mid) + ")\">" + escape_markup(panel.y2_label) + "</text>\n";
     }
 
-    // Series: polylines broken at undrawable points, then the markers on top.
-    for (std::size_t i = 0; i < panel.series.size(); ++i) {
-      const PlotSeries& s = panel.series[i];
-      const Axis& axis = y_axes[s.axis == PlotAxis::Right ? 1 : 0];
-      const char* color = kColors[i % kColorCount];
-      std::string d;
-      std::string markers;
-      bool pen_down = false;
-      for (std::size_t k = 0; k < s.x.size(); ++k) {
-        if (!drawable(s.x[k], s.y[k], plot.x_log)) {
-          pen_down = false;
-          continue;
-        }
-        const double cx = px(s.x[k]);
-        const double cy = py(axis, s.y[k]);
-        d += (pen_down ? " L" : (d.empty() ? "M" : " M")) + num(cx) + " " + num(cy);
-        pen_down = true;
-        if (s.markers) {
-          markers += "<circle class=\"marker\" cx=\"" + num(cx) + "\" cy=\"" + num(cy) +
-                     "\" r=\"3\" fill=\"" + color + "\"/>\n";
-        }
-      }
-      body += "<g class=\"series\">\n";
-      if (!d.empty()) {
-        body += "<path d=\"" + d + "\" fill=\"none\" stroke=\"" + color +
-                "\" stroke-width=\"1.8\"" +
-                (s.axis == PlotAxis::Right ? " stroke-dasharray=\"6 3\"" : "") + "/>\n";
-      }
-      body += markers + "</g>\n";
-    }
-
+    body += series_svg(panel, plot.x_log, px, [&](int a, double v) { return py(y_axes[a], v); });
     y = bottom + 24;
     if (last) {
       body += "<text class=\"xlabel\" x=\"" + num((left + right) / 2) + "\" y=\"" + num(y + 12) +

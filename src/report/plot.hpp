@@ -1,23 +1,16 @@
-// Line plots as standalone SVG files (any browser opens them), for sweeps and run-time figures.
+// Line plots as standalone SVG files for sweeps and run-time figures: panels stacked vertically
+// that share the x axis (linear or log), "nice" ticks, a left and an optional right y axis per
+// panel, a legend per panel (docs/REPORTS.md).
 //
-//   using namespace roiflow::report;
-//   Plot plot;
+//   roiflow::report::Plot plot;
 //   plot.title = "Error vs patch size";
 //   plot.x_label = "patch size (px)";
-//   PlotPanel& p = plot.panels.emplace_back();
+//   roiflow::report::PlotPanel& p = plot.panels.emplace_back();
 //   p.y_label = "AAE (deg)";
-//   p.y2_label = "EPE (px)";                      // a second y axis, on the right
-//   p.series.push_back({"AAE", xs, aae});
-//   p.series.push_back({"EPE", xs, epe, PlotAxis::Right});
-//   write_plot_svg("out/patch.svg", plot);        // atomically
-//
-// Panels are stacked vertically and share the x axis (e.g. error above, run time below). Each
-// axis gets "nice" ticks (1, 2 or 5 times a power of ten) that enclose its data; a log x axis
-// gets one tick per decade. Points are joined by lines in the order given, with a marker at
-// each (unless the series turns markers off). A point that cannot be drawn (NaN or infinite
-// coordinate, or x <= 0 on a log axis) is skipped and its line is broken there: the gap shows,
-// nothing is silently drawn at a wrong place. Inconsistent input throws roiflow::Error naming the
-// plot and the series: x and y of different lengths, no panel, a panel with no drawable point.
+//   p.y2_label = "EPE (px)";  // a second y axis, on the right
+//   p.series.push_back({"AAE", {3, 10, 17}, {5.1, 3.9, 4.2}});
+//   p.series.push_back({"EPE", {3, 10, 17}, {0.4, 0.28, 0.3}, roiflow::report::PlotAxis::Right});
+//   roiflow::report::write_plot_svg("out/patch.svg", plot);  // atomically
 #pragma once
 
 #include <string>

@@ -1,18 +1,11 @@
-// Progress: a one-line progress bar for long runs, redrawn in place on a terminal.
+// A one-line progress bar for long runs, redrawn in place on a terminal at most ~10 times a
+// second ("[####......] 120/300 frames  87.3 fps  ETA 2s"); a disabled one prints nothing, so
+// callers need no `if` around it. Not thread-safe (docs/REPORTS.md).
 //
 //   using roiflow::report::Progress;
-//   Progress progress(std::cerr, source.frame_count_hint(), Progress::stderr_is_terminal());
-//   for (...) progress.update(frames_done);     // cheap: redraws at most ~10 times a second
-//   progress.finish();                          // the final state, then a newline
-//
-// The line, rewritten after a carriage return:
-//   [#########...........] 120/300 frames  87.3 fps  ETA 2s     (total known)
-//   120 frames  87.3 fps                                        (total unknown: <= 0)
-// finish() replaces the ETA by the elapsed time ("in 3s"). The rate is the average since
-// construction. A disabled Progress prints nothing at all, so callers need no `if` around it
-// (disable it when the stream is not a terminal: a log file full of carriage returns helps no
-// one). The destructor finishes a line that was started, so an error message printed after an
-// exception starts on a line of its own. Not thread-safe: one caller at a time.
+//   Progress progress(std::cerr, 300, Progress::stderr_is_terminal());
+//   for (long long done = 1; done <= 300; ++done) progress.update(done);
+//   progress.finish();  // the final state, then a newline
 #pragma once
 
 #include <cstddef>

@@ -41,6 +41,17 @@ double peak_rss_mb() {
   return static_cast<double>(usage.ru_maxrss) / 1024.0;  // Linux reports KiB
 }
 
+nlohmann::ordered_json stages_json(const std::vector<StageTotal>& stages) {
+  nlohmann::ordered_json doc = nlohmann::ordered_json::object();
+  for (const StageTotal& s : stages) {
+    doc[s.name] = {{"calls", s.calls},
+                   {"ms_total", s.ms_total},
+                   {"ms_mean", s.ms_total / static_cast<double>(s.calls)},
+                   {"fps", rate(static_cast<double>(s.calls), s.ms_total / 1000)}};
+  }
+  return doc;
+}
+
 void RunStats::add(std::string_view stage, double ms) {
   check_stage_name(stage);
   if (!(ms >= 0) || !std::isfinite(ms)) {
@@ -67,15 +78,13 @@ nlohmann::ordered_json RunStats::to_json(double wall_seconds) const {
   nlohmann::ordered_json doc = {{"frames", frames_},
                                 {"wall_s", wall_seconds},
                                 {"fps", rate(static_cast<double>(frames_), wall_seconds)}};
-  nlohmann::ordered_json stages = nlohmann::ordered_json::object();
-  for (const Stage& s : stages_) {
-    stages[s.name] = {{"calls", s.calls},
-                      {"ms_total", s.ms_total},
-                      {"ms_mean", s.ms_total / static_cast<double>(s.calls)},
-                      {"fps", rate(static_cast<double>(s.calls), s.ms_total / 1000)}};
-  }
-  doc["stages"] = std::move(stages);
+  doc["stages"] = stages_json(stages_);
   return doc;
+}
+
+std::vector<StageTotal> RunStats::totals() const {
+  const std::lock_guard lock(mutex_);
+  return stages_;
 }
 
 std::string RunStats::format(double wall_seconds) const {

@@ -1,25 +1,15 @@
-// RunStats: where a run's time went, per stage, from any number of threads at once.
+// Where a run's time went, per stage, from any number of threads at once: stages in first-use
+// order with their calls, total and mean milliseconds and the rate each could sustain alone,
+// as JSON or as a table (docs/REPORTS.md); and the process's peak memory.
 //
 //   roiflow::report::RunStats stats;
 //   {
-//     roiflow::report::ScopedTimer timer(stats, "pyramid");   // adds its lifetime on scope exit
-//     build_pyramid(...);
+//     roiflow::report::ScopedTimer timer(stats, "pyramid");  // adds its lifetime on scope exit
 //   }
-//   stats.add("lk", 3.2);                                      // or add milliseconds yourself
+//   stats.add("lk", 3.2);  // or add milliseconds yourself
 //   stats.add_frames(1);
-//   nlohmann::ordered_json summary = stats.to_json(wall_seconds);
-//   summary["mode"] = "local";                                 // the caller adds its own fields
-//   std::cerr << stats.format(wall_seconds);
-//
-// A stage is created by its first add() and reported in first-use order, which for a pipeline
-// is the order of its nodes. to_json gives
-//   {"frames": N, "wall_s": s, "fps": N / s,
-//    "stages": {"<name>": {"calls": c, "ms_total": t, "ms_mean": t / c, "fps": c / (t / 1000)}}}
-// where a stage's fps is calls per second of its own busy time: what the stage alone could
-// sustain on one thread. A rate whose time is zero is null (JSON has no infinity).
-// Every member is thread-safe (one mutex: a few calls per frame cost nothing next to the work
-// they time). Bad values (negative or non-finite times, an empty stage name, negative frame
-// counts) throw roiflow::Error naming the value.
+//   nlohmann::ordered_json summary = stats.to_json(/*wall_seconds=*/0.01);
+//   std::cerr << stats.format(0.01) << roiflow::report::peak_rss_mb() << " MiB\n";
 #pragma once
 
 #include <chrono>
@@ -35,11 +25,22 @@ namespace roiflow::report {
 // platform does not report it. Monotonic: a long run shows whether memory stays flat.
 double peak_rss_mb();
 
+// One stage's totals, as RunStats::totals() reports them.
+struct StageTotal {
+  std::string name;
+  long long calls = 0;
+  double ms_total = 0;
+};
+
+// {"<name>": {"calls", "ms_total", "ms_mean", "fps"}, ...}, the "stages" object of to_json.
+nlohmann::ordered_json stages_json(const std::vector<StageTotal>& stages);
+
 class RunStats {
  public:
   void add(std::string_view stage, double ms);
   void add_frames(long long n);
 
+  std::vector<StageTotal> totals() const;  // first-use order
   nlohmann::ordered_json to_json(double wall_seconds) const;
   // A table for people:
   //   300 frames in 4.21 s: 71.3 fps
@@ -48,11 +49,7 @@ class RunStats {
   std::string format(double wall_seconds) const;
 
  private:
-  struct Stage {
-    std::string name;
-    long long calls = 0;
-    double ms_total = 0;
-  };
+  using Stage = StageTotal;
 
   mutable std::mutex mutex_;
   std::vector<Stage> stages_;  // first-use order; a handful, so a linear search is fastest

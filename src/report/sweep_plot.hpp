@@ -1,13 +1,10 @@
-// The figure of a parameter sweep (the paper's Fig. 7 and 8): error and run time against the
-// value of one LK parameter.
+// The figure of a parameter sweep (the paper's Fig. 7 and 8): error (AAE left, EPE right axis)
+// above and time per pair below, against the value of one LK parameter (lambda on a log axis).
 //
-//   using namespace roiflow;
-//   const std::vector<eval::SweepRow> rows = {{eval::SweepParam::Patch, 10, 3.9, 0.28, 12, 8}};
-//   report::Plot plot = report::sweep_plot(eval::SweepParam::Patch, rows, "middlebury");
-//
-// The rows of `param`: error (AAE left, EPE right axis) vs the value above, time (ms per pair)
-// below; lambda on a log axis. `subtitle` (e.g. the data set) goes into the title. Throws
-// roiflow::Error when no row is of `param`.
+//   const std::vector<roiflow::eval::SweepRow> rows = {
+//       {roiflow::eval::SweepParam::Patch, 10, 3.9, 0.28, 12, 8}};
+//   const roiflow::report::Plot plot =
+//       roiflow::report::sweep_plot(roiflow::eval::SweepParam::Patch, rows, "middlebury");
 #pragma once
 
 #include <string>

@@ -1,11 +1,10 @@
-// DeferredImage: a picture that is made only when somebody first asks for it, on the asking
-// thread, once. A video's frames carry their BGR picture this way when the source was asked to
-// defer it (VideoSourceParams::defer_colour): the tracker needs only the gray frame for most
-// frames, and converting the decoder's planes to BGR was 40 % of decoding (pipeline_bench,
-// synthetic 640x480 MPEG-4).
+// A picture made only when somebody first asks for it, on the asking thread, once (thread-safe).
+// A video's frames carry their BGR picture this way when the source defers colour: the tracker
+// needs only the gray frame for most frames.
 //
-//   stages::Frame f = *source.next();
-//   cv::Mat bgr = f.picture();   // f.image, else the deferred picture (made now), else f.gray
+//   const auto deferred = std::make_shared<const roiflow::stages::DeferredImage>(
+//       [&] { return bgr.clone(); });                // not run yet
+//   const cv::Mat picture = roiflow::stages::picture_of(cv::Mat(), deferred, frame_t);  // now
 #pragma once
 
 #include <functional>

@@ -4,8 +4,9 @@
 // VideoSink's PNG frames: 000001.flo holds the flow from frame 1 to frame 2.
 //
 //   roiflow::stages::FlowFileSink sink("run/flow", roiflow::stages::FlowFileFormat::Kitti);
-//   sink.write(result.flow);                   // run/flow/000001.png
-//   cv::Mat bytes = sink.encode(next.flow);    // on any thread (e.g. a parallel graph node) ...
+//   const cv::Mat flow(frame_t.size(), CV_32FC2, cv::Scalar(1.f, 2.f));
+//   sink.write(flow);                          // run/flow/000001.png
+//   cv::Mat bytes = sink.encode(flow);         // on any thread (e.g. a parallel graph node) ...
 //   sink.write_encoded(bytes);                 // ... then written in order: 000002.png
 //
 // encode() is const and thread-safe; the costly part of a KITTI file (the 16-bit encoding and

@@ -1,27 +1,16 @@
-// GlobalDetector: the paper's global treatment — find the moving object in the whole frame.
+// The paper's global treatment: find the moving object in the whole frame, by a background
+// model (fixed camera, nothing known: MOG2 on a reduced copy, morphology, contours; the target's
+// colour/shape/size signature picks it among the moving objects) or by its appearance (a known
+// target, or a moving camera: multi-scale normalised cross-correlation of its template).
+// docs/STAGES.md has the details.
 //
-//   using namespace roiflow::stages;
-//   GlobalDetector detector;
-//   while (auto f = source.next()) {
-//     detector.observe(f->image);                         // every frame: background model
-//     if (!tracking) {
-//       auto objects = detector.moving_objects();         // biggest first
-//       if (!objects.empty()) detector.set_target(f->image, objects[0].box), tracking = true;
-//     } else if (lost) {
-//       auto found = detector.find_target(f->image, f->gray, predicted_centre, by_appearance);
-//     }
-//   }
-//
-// Two ways to find an object:
-//  - fixed camera, nothing known: a background model updated by observe() (OpenCV's MOG2 on a
-//    reduced copy of the frame, so that keeping it up to date every frame costs little), the
-//    foreground mask cleaned by morphology, its external contours, and for each object the
-//    bounding box and the barycentre of its edge contour. Objects below `min_area` are noise.
-//  - known object (the target was given as a box, OTB protocol, or the camera moves): its
-//    appearance — the template captured by set_target() — searched over the whole frame by
-//    multi-scale normalised cross-correlation (stages/template_search.hpp).
-// The target's signature (colour histogram, edge-shape moments, size) picks, among the moving
-// objects, the one that is the target when it is found again by background subtraction.
+//   roiflow::stages::GlobalDetector detector;
+//   detector.observe(bgr);  // every frame (or every k-th, with weight k): the background model
+//   const std::vector<roiflow::stages::Detection> objects = detector.moving_objects();
+//   if (objects.empty()) return;  // warm-up, or nothing moves
+//   detector.set_target(bgr, objects[0].box);  // biggest first
+//   const auto found = detector.find_target(bgr, frame_t, {320, 240}, /*by_appearance=*/true);
+//   if (found) std::cout << found->box << "\n";
 #pragma once
 
 #include <memory>

@@ -1,19 +1,11 @@
-// Template search: where a known appearance is in an image, by normalised cross-correlation.
+// Where a known appearance is in an image: normalised cross-correlation (OpenCV's
+// TM_CCOEFF_NORMED) of the template at several scales over a search region, the best position
+// refined to sub-pixel; large templates are searched coarse to fine (docs/STAGES.md).
 //
-//   using namespace roiflow::stages;
-//   TemplateMatch m = match_template(gray, target_patch, search_rect, {0.95, 1.0, 1.05});
-//   if (m.score > 0.6) box = m.box;   // sub-pixel top-left, size = template size x best scale
-//
-// For every scale the template is resized (area interpolation when shrinking, linear when
-// growing) and matched with OpenCV's TM_CCOEFF_NORMED (zero-mean NCC, in [-1, 1]) at every
-// position where it lies wholly inside `search` (clipped to the image). The best position gets
-// a parabolic sub-pixel refinement in x and y. A search region too small for a scaled template
-// skips that scale; if every scale is skipped the result has score -1 and an empty box.
-//
-// Large templates are searched coarse to fine: when the template's shorter side exceeds
-// `coarse_side`, image and template are first shrunk so that it is about `coarse_side` pixels,
-// the best coarse position is found over the whole region, and only a small window around it is
-// searched at full resolution. That keeps a whole-frame re-detection in the milliseconds.
+//   const cv::Mat templ = frame_t(cv::Rect(100, 100, 40, 30)).clone();
+//   const roiflow::stages::TemplateMatch m = roiflow::stages::match_template(
+//       frame_t1, templ, cv::Rect(60, 60, 120, 110), {{0.95, 1.0, 1.05}});
+//   if (m.score > 0.6) std::cout << m.box << "\n";  // sub-pixel top-left, scaled size
 #pragma once
 
 #include <opencv2/core.hpp>

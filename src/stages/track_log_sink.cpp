@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <string>
 
+#include "core/atomic_write.hpp"
 #include "core/error.hpp"
 
 namespace roiflow::stages {
@@ -18,6 +19,14 @@ std::string lowercase_extension(const std::string& path) {
 }
 
 }  // namespace
+
+void check_track_log_path(const std::string& path, const std::string& option) {
+  check_output_path(path, option);
+  const std::string ext = lowercase_extension(path);
+  if (ext != ".csv" && ext != ".json") {
+    throw UsageError(option + ": '" + path + "' must end in .csv or .json");
+  }
+}
 
 TrackLogWriter::TrackLogWriter(const std::string& path) : path_(path) {
   const std::string ext = lowercase_extension(path);

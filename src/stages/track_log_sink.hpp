@@ -1,16 +1,13 @@
-// TrackLogWriter: the track log written while a run goes, one record per frame, as CSV or JSON
-// (the format: eval/track_log.hpp).
+// The track log written while a run goes, one record per frame, as CSV or JSON (the format:
+// eval/track_log.hpp), each record flushed at once and a JSON array kept valid after every
+// record, so a run that dies leaves a complete, parseable log up to its last frame.
 //
-//   roiflow::stages::TrackLogWriter log("run/track.csv");   // or .json; opened (and checked) now
-//   log.write({.frame = 1, .box = {70, 51, 107, 87}});      // written and flushed at once
-//   log.close();                                            // or let the destructor do it
-//
-// Every record is flushed as it is written, so a run that dies leaves a log complete up to its
-// last frame. The JSON array is re-closed after every record (the `]` is overwritten by the
-// next one), so the file is valid JSON at every moment except during the write of one line:
-// even SIGKILL leaves a parseable log. (That rewrite needs a seekable file: not a pipe.) Write
-// errors and values a reader could not take back (NaN, infinity, a frame below 1, a negative
-// size) throw roiflow::Error.
+//   roiflow::stages::check_track_log_path("run/track.csv", "--log");  // before the run
+//   roiflow::stages::TrackLogWriter log("run/track.csv");  // or .json; opened (and checked) now
+//   roiflow::eval::TrackRecord r;
+//   r.box = {70, 51, 107, 87};
+//   log.write(r);  // written and flushed at once
+//   log.close();                                          // or let the destructor do it
 #pragma once
 
 #include <fstream>
@@ -42,5 +39,9 @@ class TrackLogWriter {
   long long records_ = 0;
   std::streampos array_end_;  // JSON: where the closing bracket starts, overwritten next
 };
+
+// Before a run: check_output_path(path, option), and UsageError "<option>: 'p' must end in .csv
+// or .json" for a name TrackLogWriter would refuse.
+void check_track_log_path(const std::string& path, const std::string& option);
 
 }  // namespace roiflow::stages

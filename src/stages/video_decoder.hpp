@@ -1,39 +1,13 @@
-// VideoDecoder: the frames of a video file, decoded with FFmpeg's libavformat/libavcodec, as
-// 8-bit BGR and 8-bit gray, in order. VideoSource reads video files through it.
+// The frames of a video file decoded with FFmpeg's libavformat/libavcodec, in order, as 8-bit
+// gray (the decoder's own luma plane, no conversion) and 8-bit BGR (one conversion, or deferred),
+// buffers recycled. VideoSource reads video files through it; docs/STAGES.md says why not
+// cv::VideoCapture.
 //
 //   roiflow::stages::VideoDecoder video("car.mp4");
 //   roiflow::stages::DecodedFrame f;
 //   std::string failure;
-//   while (video.read(f, failure)) use(f.bgr, f.gray, f.timestamp_s);
-//   if (!failure.empty()) std::cerr << failure << '\n';   // a decode error, not the end
-//
-// Why not cv::VideoCapture: it converts every frame to BGR, then copies it into the caller's
-// Mat, and the caller converts that to gray again; with frame threads on (it always asks
-// FFmpeg for them) a 640x480 MPEG-4 stream decodes slower than on one thread and keeps both
-// cores of a two-core machine busy doing it (pipeline_bench BM_DecodeOpenCV: 1.6 cores, ~0.9 ms
-// of CPU a frame, against ~0.45 ms here on one core). Here the gray frame is the decoder's own luma
-// plane (expanded from video range 16..235 to 0..255, so it equals the BT.601 gray of the BGR frame
-// within rounding), the BGR frame is converted once into its final buffer, and both come from
-// a small pool of buffers that are reused once nobody else holds them (no page faults per
-// frame).
-//
-// Deferred colour: with `defer_bgr`, frames of formats whose plane 0 is the luma (all YUV ones)
-// come with an empty `bgr` and a DeferredImage that converts them on the thread that first asks
-// (a swscale context and buffer pool shared with the decoder, thread-safe); the gray frame is
-// always made at once. Other formats (RGB, palette) are converted at once as before.
-//
-// Decoder threads: `threads` > 0 asks FFmpeg for that many; 0 picks one thread for frames of
-// up to kSingleThreadPixels (where FFmpeg's frame threads cost more than they give: synthetic
-// 640x480 MPEG-4, 3850 frames/s on one thread vs 2370-2940 on two or three) and FFmpeg's own
-// choice (one per core) for larger ones. A tracking pipeline wants its other cores for itself.
-//
-// Errors: the constructor throws roiflow::Error naming the file when it cannot be opened, has
-// no video stream or no decoder for it, or `threads` < 0 (the frame-size limits are
-// VideoSource's, checked on size() before any frame is decoded). read() returns false at the
-// end of the stream (failure empty) or when a packet cannot be decoded, a frame cannot be
-// converted, or the frame size changes mid-stream (failure says which): the caller stops
-// there. The FFmpeg log level follows OPENCV_FFMPEG_LOGLEVEL when it is set, as with OpenCV's
-// own FFmpeg backend.
+//   while (video.read(f, failure)) std::cout << f.timestamp_s << " s\n";
+//   if (!failure.empty()) std::cerr << failure << '\n';  // a decode error, not the end
 #pragma once
 
 #include <memory>

@@ -16,6 +16,8 @@
 
 #include "core/atomic_write.hpp"
 #include "core/error.hpp"
+#include "core/text.hpp"
+#include "eval/image_io.hpp"
 
 namespace roiflow::stages {
 namespace {
@@ -39,10 +41,6 @@ std::string lowercase(std::string text) {
   std::transform(text.begin(), text.end(), text.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return text;
-}
-
-std::string size_text(cv::Size size) {
-  return std::to_string(size.width) + "x" + std::to_string(size.height);
 }
 
 std::string frame_name(long long number) {

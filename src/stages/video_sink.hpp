@@ -1,30 +1,13 @@
-// VideoSink: frames out, as a video file or a folder of numbered PNG images.
+// Frames out, as a video file (.mp4, .mov, .mkv: mp4v; .avi: Motion JPEG; OpenCV's FFmpeg
+// backend) or as a folder of numbered PNG images each written atomically (no extension, a
+// trailing '/', or an existing directory); docs/STAGES.md has the details.
 //
-//   roiflow::stages::VideoSink sink("run/annotated.mp4", source.fps(), source.size());
-//   while (...) sink.write(annotate_frame(frame.image, out));   // 8-bit BGR or gray
-//   cv::Mat png = sink.encode(picture);      // on any thread (e.g. a parallel graph node) ...
-//   sink.write_encoded(png);                 // ... then written in order
+//   roiflow::stages::VideoSink sink("run/annotated.mp4", 25.0, bgr.size());
+//   sink.write(bgr);  // 8-bit BGR or gray, of that size
+//   const cv::Mat png = sink.encode(bgr);  // on any thread (a parallel graph node) ...
+//   sink.write_encoded(png);               // ... then written in order
 //   std::cerr << sink.description() << ": " << sink.frames() << " frames\n";
-//   sink.close();                                                // or let the destructor do it
-//
-// What the path means:
-//   - an extension .mp4 or .mov (MPEG-4 part 2, fourcc mp4v), .avi (Motion JPEG, MJPG) or .mkv
-//     (mp4v), in any case: a video written with OpenCV's FFmpeg backend;
-//   - no extension, a trailing '/', or an existing directory: a folder of PNG frames
-//     000001.png, 000002.png, ... (1-based, like the track log's frames), created if missing;
-//     each frame is written atomically (see atomic_write.hpp), so the folder only ever holds
-//     whole images;
-//   - any other extension throws: "out.png" or "out.jpg" is more likely a mistake than a
-//     folder's name (write "out.png/" to mean one).
-// Errors throw roiflow::Error naming the path: bad fps or size, a video the backend cannot
-// open (e.g. its directory does not exist), a folder that cannot be created, a frame that is
-// empty, not 8-bit gray or BGR (gray is converted), or of another size than the sink's, and
-// a write after close().
-//
-// close() is idempotent and the destructor calls it (never throwing), so a run interrupted by
-// an exception still leaves a playable video holding every frame written so far. (A process
-// killed outright cannot finalise an .mp4's index; .avi and PNG folders survive that better.)
-// Not thread-safe, but for encode(): one writer at a time.
+//   sink.close();  // or let the destructor do it
 #pragma once
 
 #include <memory>

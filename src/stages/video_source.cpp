@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/text.hpp"
 #include "eval/synthetic_input.hpp"
 #include "eval/tracking_scene.hpp"
 #include "eval/traffic_scene.hpp"
@@ -46,10 +47,6 @@ namespace fs = std::filesystem;
 
 std::string quoted(const std::string& text) {
   return "'" + text + "'";
-}
-
-std::string size_string(cv::Size size) {
-  return std::to_string(size.width) + "x" + std::to_string(size.height);
 }
 
 std::string number_string(double value) {
@@ -530,8 +527,8 @@ std::optional<Frame> VideoSource::read_frame(long long index, std::string& failu
       return std::nullopt;
     }
   } else if (checked.size() != size_) {
-    failure = "frame size " + size_string(checked.size()) + " differs from the first frame's " +
-              size_string(size_);
+    failure = "frame size " + size_text(checked.size()) + " differs from the first frame's " +
+              size_text(size_);
     return std::nullopt;
   }
   if (!deferred && frame.image.channels() == 1)
@@ -557,7 +554,7 @@ long long VideoSource::frame_count_hint() const {
 }
 
 std::string VideoSource::description() const {
-  std::string text = reader_->description() + ", " + size_string(size_);
+  std::string text = reader_->description() + ", " + size_text(size_);
   if (params_.start > 0) text += ", from frame " + std::to_string(params_.start);
   if (params_.max_frames > 0) text += ", at most " + std::to_string(params_.max_frames) + " frames";
   return text;

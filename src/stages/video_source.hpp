@@ -1,64 +1,14 @@
-// VideoSource: frames, in order, from a video file, an image-sequence folder or a camera.
+// Frames, in order, from a video file (FFmpeg), an image-sequence folder (OTB's img/ layout or
+// numbered files), a printf pattern ("img/%04d.jpg"), a camera index ("0") or a generated stream
+// ("synthetic:N[:WxH][:OBJECTS]"). Bad inputs and frame sizes out of the limits throw
+// roiflow::Error at construction (the first frame is decoded there); mid-stream the policy is
+// STOP, never skip: next() ends and status() says where and why. docs/STAGES.md has details.
 //
-//   roiflow::stages::VideoSource source("data/Car4");  // or "car.mp4", "img/%04d.jpg", "0",
-//                                                      // "synthetic:1000"
-//   while (auto frame = source.next()) track(frame->gray, frame->index, frame->timestamp_s);
-//   if (source.status().state == SourceStatus::State::kStopped) {
-//     std::cerr << source.status().message << '\n';           // "stopped at frame 41: ..."
-//     return 1;
+//   roiflow::stages::VideoSource source("synthetic:10");  // or "car.mp4", "data/Car4", "0"
+//   while (auto frame = source.next()) std::cout << frame->index << " " << frame->timestamp_s;
+//   if (source.status().state == roiflow::stages::SourceStatus::State::kStopped) {
+//     std::cerr << source.status().message << '\n';  // "stopped at frame 41: ..."
 //   }
-//
-// What the input string means, tried in this order:
-//   - only digits ("0"): a camera index, opened with OpenCV's default backend. Write "./0" for
-//     a file or folder called 0.
-//   - an existing directory: an image sequence in DIR/img (the OTB layout) or else in DIR.
-//     Numbered files (prefix, digits, extension .jpg .jpeg .png .bmp .pgm .ppm .tif .tiff) are
-//     grouped by prefix and extension; the largest group wins. Its frames are the consecutive
-//     run of numbers starting at the smallest one (0001.jpg, 0002.jpg, ... or 1.png, 2.png ...).
-//   - an existing file: a video, decoded with FFmpeg (VideoDecoder: the gray frame is the
-//     decoder's luma plane, the BGR frame one conversion; buffers recycled).
-//   - a path holding one printf conversion (%d, %4d or %04d), like "img/%04d.jpg": an image
-//     sequence made of the files of that folder that match, run as above.
-//   - "synthetic:N" or "synthetic:N:WxH" (when no such file exists): N frames (1..10^9) of
-//     eval::TrackingScene's fixed-camera scene, WxH (default 640x480, each side 64..8192; the
-//     vehicle and its jump scaled with the width), rendered on the fly. The scene is 300
-//     frames long and plays forwards, then backwards, then forwards again (frame i shows scene
-//     frame i mod 598, mirrored past 299), so a stream of any length holds one scene and one
-//     frame at a time: the input of soak runs.
-//   - "synthetic:N[:WxH]:OBJECTS": N frames of eval::TrafficScene, OBJECTS (1..256) vehicles
-//     crossing, entering and leaving, whose exact boxes eval::TrafficScene::ground_truth()
-//     gives (eval/synthetic_input.hpp parses the spec).
-//
-// Frame size limits: every frame must be at most kMaxFrameSide pixels a side and kMaxFramePixels
-// pixels in all (8K UHD, 7680x4320, fits), and at least kMinFrameSide a side (the smallest
-// pyramid level LK can work on). A video whose container announces a size out of range is
-// refused before any frame is decoded; an image is refused once decoded, before any buffer
-// of the pipeline is allocated for it.
-//
-// Errors at construction: every one of these throws roiflow::Error naming the input: a path
-// that does not exist, a directory without an image sequence, a pattern nothing matches, a
-// file FFmpeg cannot open (or whose video it cannot decode), a camera that does not open, bad
-// params, a frame size out of the limits above, a malformed "synthetic:" input, and an input that
-// opens but yields no first frame (empty or corrupt file, `start` past the end). The first frame is
-// decoded in the constructor so that size() is known and a bad input fails before any work starts.
-//
-// Frames are decoded on demand in next() (only the first ahead of time, so a camera's frames
-// are never a frame late), each into its own buffers: a frame may travel to other threads
-// while the next one is read. The class itself is not thread-safe: one caller at a time.
-//
-// Mid-stream policy: STOP, never skip. When a frame after the first cannot be delivered,
-// next() returns std::nullopt, from then on, and status() says kStopped with the message
-// "stopped at frame N: <reason>", N being the index the frame would have had. Reasons: a
-// missing file in a sequence (a gap in the numbering: the files after it are not read; the
-// message names the missing file), an image that cannot be decoded or is a truncated or damaged
-// PNG or JPEG (see read_image), a frame whose size differs
-// from the first one's (the pipeline needs one size), a video that ends more than ~1% short of
-// the frame count its container announces (truncated or corrupt; OpenCV does not tell a
-// decode error from the end, and counts estimated from the duration can be off by a frame or
-// two), and a camera that stops delivering. Every frame delivered before is intact, so a
-// caller keeps what it has written and decides whether to exit non-zero. A normal end, or
-// `max_frames` reached, is kEnded with the message "end of stream". Until next() has returned
-// std::nullopt the state is kStreaming.
 #pragma once
 
 #include <memory>

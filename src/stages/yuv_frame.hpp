@@ -3,11 +3,12 @@
 // tracker fed from there sees what `roiflow track` sees on the same decoded video.
 //
 //   using namespace roiflow;
+//   const cv::Mat luma(240, 320, CV_8UC1, cv::Scalar(90)), cb(120, 160, CV_8UC1, 128), cr = cb;
 //   stages::YuvPlanes p;                       // the planes, copied or borrowed
 //   p.y = luma; p.u = cb; p.v = cr;            // I420; NV12: p.u = interleaved CbCr, p.nv12 = true
 //   p.full_range = false;                      // video range 16..235 (most video)
 //   cv::Mat gray = stages::yuv_gray(p);        // 8-bit, full range (the BT.601 gray)
-//   cv::Mat bgr = stages::yuv_to_bgr(p);       // 8-bit BGR, swscale (bicubic chroma)
+//   cv::Mat colour = stages::yuv_to_bgr(p);       // 8-bit BGR, swscale (bicubic chroma)
 //
 // yuv_gray expands video-range luma to 0..255 (full range copies it); yuv_to_bgr converts with
 // the same swscale settings as VideoDecoder. Both throw roiflow::Error on planes whose sizes do

@@ -1,0 +1,24 @@
+// What `roiflow score` prints for a multi-object track (score --mot): CLEAR-MOT and IDF1 as a
+// table for people, or the headline figures as JSON.
+//
+//   const auto s = roiflow::eval::score_mot(roiflow::eval::read_mot("mot.txt", "tracker output"),
+//                                           roiflow::eval::read_mot("gt.txt", "ground truth"));
+//   std::cout << roiflow::eval::mot_score_table(s);
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "eval/mot.hpp"
+
+namespace roiflow::eval {
+
+// The ground truth `roiflow score --mot` scores against: a MOTChallenge file, or the exact boxes
+// of a synthetic traffic input (synthetic:N[:WxH]:OBJECTS, when no such file exists).
+std::vector<MotBox> read_mot_truth(const std::string& gt);
+// MOTA, MOTP, IDF1 (IDP, IDR) to 4 decimals, ID switches, FP, FN, matches, frames, objects.
+std::string mot_score_table(const MotScore& s);
+// {"mota", "motp", "idf1", "id_switches", "fp", "fn", "frames", "objects"}.
+nlohmann::ordered_json mot_score_json(const MotScore& s);
+
+}  // namespace roiflow::eval

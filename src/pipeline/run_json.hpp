@@ -1,0 +1,29 @@
+// The run summaries as JSON documents (what `roiflow track --summary` and `roiflow dense
+// --summary` write): every field of the typed summary, in a fixed order, with the per-stage
+// times as report::stages_json gives them; and a tracking run's two lines for people.
+//
+//   roiflow::stages::VideoSource source("synthetic:10");
+//   const auto s = roiflow::pipeline::run_track_video(source, {});
+//   nlohmann::ordered_json doc = roiflow::pipeline::to_json(s);
+//   doc["input"] = s.input;  // callers add what their document needs beyond the run's figures
+//   std::cout << doc.dump(2) << "\n" << roiflow::pipeline::summary_text("track", s);
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "pipeline/run.hpp"
+
+namespace roiflow::pipeline {
+
+// mode, frames, global_activations, lost_frames, fps, tracker_fps, tracker_ms_per_frame, wall_s,
+// threads, roi, max_in_flight, peak_rss_mb, stages.
+nlohmann::ordered_json to_json(const TrackSummary& s);
+// mode ("dense"), input, frames, pairs, fps, flow_ms_per_pair, wall_s, threads, preset, status,
+// peak_rss_mb, stages.
+nlohmann::ordered_json to_json(const DenseSummary& s, const std::string& preset);
+// "<what>: N frames in S s, F fps overall, tracker T fps (M ms/frame, decode excluded), mode m"
+// and "  global activations G, frames lost L, N threads", each ending in '\n'.
+std::string summary_text(const std::string& what, const TrackSummary& s);
+
+}  // namespace roiflow::pipeline
