@@ -5,6 +5,7 @@
 //   roiflow eval data/middlebury --format csv -o errors.csv
 //   roiflow eval data/sintel/training --pass final --max-pairs 50 --report sintel.html
 //   roiflow score track.csv Car4/groundtruth_rect.txt --format json
+//   roiflow score --mot mot.txt PETS09-S2L1/gt/gt.txt --format json
 //
 // Each subcommand is a thin layer: CLI11 parses, the library computes, this file prints.
 // Failures print one line, `roiflow: error: <message>`, on stderr: exit code 2 for a bad
@@ -329,9 +330,11 @@ struct ScoreCommand {
   std::string track;
   std::string ground_truth;
   std::string format = "table";
+  bool mot = false;
 };
 
 void run_score(const ScoreCommand& cmd) {
+  if (cmd.mot) return print_mot_score(cmd.track, cmd.ground_truth, cmd.format);
   const std::vector<eval::TrackRecord> records = eval::read_track_csv(cmd.track);
   std::vector<cv::Rect2f> track;
   try {
@@ -373,6 +376,9 @@ void add_score_command(CLI::App& app, ScoreCommand& cmd) {
       ->type_name("FORMAT")
       ->check(CLI::IsMember({"table", "json"}))
       ->capture_default_str();
+  sub->add_flag("--mot", cmd.mot,
+                "multi-object: TRACK and GROUNDTRUTH are MOTChallenge files (GROUNDTRUTH may be "
+                "synthetic:N[:WxH]:OBJECTS); CLEAR-MOT and IDF1");
   sub->callback([&cmd] { run_score(cmd); });
 }
 
@@ -420,6 +426,8 @@ int main(int argc, char** argv) {
   int exit_code = 0;
   add_video_commands(app, exit_code);
   add_sweep_command(app);
+  add_scaling_command(app);
+  add_benchmark_command(app);
 
   try {
     app.parse(argc, argv);

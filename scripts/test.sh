@@ -26,3 +26,4 @@ if [[ ! -d $data ]]; then
 fi
 scripts/eval_gate.sh "$data"
 scripts/track_gate.sh "$data/tracking/Car4"
+scripts/benchmark_gate.sh "$data/tracking"

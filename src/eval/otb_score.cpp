@@ -17,8 +17,7 @@
 namespace roiflow::eval {
 namespace {
 
-constexpr int kThresholds = 21;  // IoU 0, 0.05, ..., 1
-constexpr double kPrecisionPixels = 20;
+constexpr int kPrecisionPixels = 20;
 
 bool is_finite(const cv::Rect2f& r) {
   return std::isfinite(r.x) && std::isfinite(r.y) && std::isfinite(r.width) &&
@@ -61,23 +60,22 @@ std::vector<std::string_view> split_values(std::string_view line, const std::str
   return values;
 }
 
-cv::Rect2f parse_box(std::string_view line, const std::string& where) {
-  const std::vector<std::string_view> text = split_values(line, where);
-  if (text.size() != 4) {
-    throw Error(where + "expected 4 values x,y,w,h, got " + std::to_string(text.size()));
-  }
+// The four numbers x,y,w,h of `text` (values `first`..`first + 3`), checked as described in
+// the header; `line` is quoted in messages.
+cv::Rect2f parse_box_values(const std::vector<std::string_view>& text, std::size_t first,
+                            std::string_view line, const std::string& where) {
   double v[4];
   int nans = 0;
   for (int k = 0; k < 4; ++k) {
-    const std::string_view t = text[k];
+    const std::string_view t = text[first + k];
     const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v[k]);
     if (ec != std::errc() || end != t.data() + t.size() || std::isinf(v[k])) {
-      throw Error(where + "value " + std::to_string(k + 1) + " " + quoted_excerpt(t) +
+      throw Error(where + "value " + std::to_string(first + k + 1) + " " + quoted_excerpt(t) +
                   " is not a finite number");
     }
     // Boxes are floats: a larger value would become infinity (found by fuzzing).
     if (std::abs(v[k]) > std::numeric_limits<float>::max()) {
-      throw Error(where + "value " + std::to_string(k + 1) + " " + quoted_excerpt(t) +
+      throw Error(where + "value " + std::to_string(first + k + 1) + " " + quoted_excerpt(t) +
                   " is too large");
     }
     if (std::isnan(v[k])) ++nans;
@@ -86,19 +84,71 @@ cv::Rect2f parse_box(std::string_view line, const std::string& where) {
     throw Error(where + "partly NaN box " + quoted_excerpt(line) + " (an absent target is 4 NaN)");
   }
   if (v[2] < 0 || v[3] < 0) {
-    throw Error(where + "negative size " + std::string(text[2]) + "x" + std::string(text[3]));
+    throw Error(where + "negative size " + std::string(text[first + 2]) + "x" +
+                std::string(text[first + 3]));
   }
   return {static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2]),
           static_cast<float>(v[3])};
+}
+
+// An integer value of a TinyTLP line (its frame number or its absent flag).
+long long parse_integer(std::string_view t, std::size_t index, const std::string& where) {
+  long long value = 0;
+  const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), value);
+  if (ec != std::errc() || end != t.data() + t.size()) {
+    throw Error(where + "value " + std::to_string(index + 1) + " " + quoted_excerpt(t) +
+                " is not an integer");
+  }
+  return value;
+}
+
+constexpr std::size_t kOtbColumns = 4;      // x,y,w,h
+constexpr std::size_t kTinyTlpColumns = 6;  // frame,x,y,w,h,absent
+
+// One line of a file whose first line had `columns` values; `number` is the box's 1-based index.
+cv::Rect2f parse_box(std::string_view line, std::size_t columns, long long number,
+                     const std::string& where) {
+  const std::vector<std::string_view> text = split_values(line, where);
+  if (text.size() != columns) {
+    if (columns == kTinyTlpColumns) {
+      throw Error(where +
+                  "expected 6 values frame,x,y,w,h,absent (TinyTLP, as the first line), got " +
+                  std::to_string(text.size()));
+    }
+    throw Error(where + "expected 4 values x,y,w,h, got " + std::to_string(text.size()) +
+                (number == 1 ? " (TinyTLP files have 6: frame,x,y,w,h,absent)" : ""));
+  }
+  if (columns == kOtbColumns) return parse_box_values(text, 0, line, where);
+  const long long frame = parse_integer(text[0], 0, where);
+  if (frame != number) {
+    throw Error(where + "TinyTLP frame number " + std::to_string(frame) + ", expected " +
+                std::to_string(number) + " (frames must run 1, 2, 3, ...)");
+  }
+  const long long absent = parse_integer(text[5], 5, where);
+  if (absent != 0 && absent != 1) {
+    throw Error(where + "TinyTLP absent flag " + std::string(text[5]) + " is neither 0 nor 1");
+  }
+  const cv::Rect2f box = parse_box_values(text, 1, line, where);
+  if (absent == 1) {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    return {nan, nan, nan, nan};
+  }
+  return box;
 }
 
 }  // namespace
 
 std::vector<cv::Rect2f> parse_ground_truth(std::string_view text, const std::string& name) {
   std::vector<cv::Rect2f> boxes;
+  std::size_t columns = 0;  // the first line's count decides the format
   for_each_line(text, [&](long long number, std::string_view line) {
     if (line.find_first_not_of(" \t") == std::string_view::npos) return;
-    boxes.push_back(parse_box(line, name + ":" + std::to_string(number) + ": "));
+    const std::string where = name + ":" + std::to_string(number) + ": ";
+    if (columns == 0) {
+      const std::size_t n = split_values(line, where).size();
+      columns = n == kTinyTlpColumns ? kTinyTlpColumns : kOtbColumns;
+    }
+    boxes.push_back(parse_box(line, columns, static_cast<long long>(boxes.size()) + 1, where));
   });
   if (boxes.empty()) throw Error("ground truth '" + name + "' holds no box");
   return boxes;
@@ -145,37 +195,68 @@ double center_error(const cv::Rect2f& a, const cv::Rect2f& b) {
   return std::hypot(dx, dy);
 }
 
-OtbScore score(const std::vector<cv::Rect2f>& track, const std::vector<cv::Rect2f>& truth) {
-  const std::size_t n = std::min(track.size(), truth.size());
-  long long above[kThresholds] = {};
-  long long precise = 0;
+namespace {
+
+struct Tally {
+  OtbCurves curves;
   double iou_sum = 0;
-  OtbScore s;
+};
+
+Tally tally(const std::vector<cv::Rect2f>& track, const std::vector<cv::Rect2f>& truth) {
+  const std::size_t n = std::min(track.size(), truth.size());
+  std::vector<long long> above(kSuccessThresholds, 0);
+  std::vector<long long> near(kPrecisionThresholds, 0);
+  Tally t;
+  long long& frames = t.curves.frames;
   for (std::size_t i = 0; i < n; ++i) {
     if (!is_finite(truth[i]) || !has_area(truth[i])) continue;
     const double overlap = iou(track[i], truth[i]);
-    for (int k = 0; k < kThresholds; ++k) {
+    for (int k = 0; k < kSuccessThresholds; ++k) {
       // k / 20 rather than k * 0.05: the threshold 0.5 is then exactly 0.5.
-      if (overlap > static_cast<double>(k) / (kThresholds - 1)) ++above[k];
+      if (overlap > static_cast<double>(k) / (kSuccessThresholds - 1)) ++above[k];
     }
-    if (center_error(track[i], truth[i]) <= kPrecisionPixels) ++precise;
-    iou_sum += overlap;
-    ++s.frames;
+    const double error = center_error(track[i], truth[i]);
+    for (int k = 0; k < kPrecisionThresholds; ++k) {
+      if (error <= k) ++near[k];
+    }
+    t.iou_sum += overlap;
+    ++frames;
   }
-  if (s.frames == 0) {
+  if (frames == 0) {
     throw Error("no frame to score: the track has " + std::to_string(track.size()) +
                 " boxes, the ground truth " + std::to_string(truth.size()) + ", and " +
                 (n == 0
                      ? std::string("none to compare")
                      : "the target is absent in all " + std::to_string(n) + " frames they share"));
   }
-  const double frames = static_cast<double>(s.frames);
-  double success_sum = 0;
-  for (long long count : above)
-    success_sum += static_cast<double>(count) / frames;
-  s.auc = success_sum / kThresholds;
-  s.precision20 = static_cast<double>(precise) / frames;
-  s.mean_iou = iou_sum / frames;
+  const double count = static_cast<double>(frames);
+  for (long long a : above)
+    t.curves.success.push_back(static_cast<double>(a) / count);
+  for (long long a : near)
+    t.curves.precision.push_back(static_cast<double>(a) / count);
+  return t;
+}
+
+}  // namespace
+
+OtbCurves otb_curves(const std::vector<cv::Rect2f>& track, const std::vector<cv::Rect2f>& truth) {
+  return tally(track, truth).curves;
+}
+
+double curve_auc(const std::vector<double>& success) {
+  double sum = 0;
+  for (double v : success)
+    sum += v;
+  return success.empty() ? 0.0 : sum / static_cast<double>(success.size());
+}
+
+OtbScore score(const std::vector<cv::Rect2f>& track, const std::vector<cv::Rect2f>& truth) {
+  const Tally t = tally(track, truth);
+  OtbScore s;
+  s.frames = t.curves.frames;
+  s.auc = curve_auc(t.curves.success);
+  s.precision20 = t.curves.precision[static_cast<std::size_t>(kPrecisionPixels)];
+  s.mean_iou = t.iou_sum / static_cast<double>(s.frames);
   return s;
 }
 

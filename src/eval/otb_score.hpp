@@ -47,9 +47,12 @@ struct OtbScore {
 
 // One box `x,y,w,h` per line, the values separated by commas, tabs or spaces (OTB files mix
 // them, and end lines with CRLF). Blank lines are skipped. A line of four NaN marks the target
-// absent and is kept, as NaN, so that line numbers stay frame numbers. Missing files, another
-// number of values, text that is not a number, infinities, values beyond the float range, a partly
-// NaN line and a negative size throw roiflow::Error as `path:line: what was wrong`.
+// absent and is kept, as NaN, so that line numbers stay frame numbers. A file whose first line
+// holds 6 values is TinyTLP's `frame,x,y,w,h,absent`: frames must run 1, 2, 3, ..., and a line
+// with absent = 1 marks the target absent (kept as NaN); absent is 0 or 1, and every line has 6.
+// Missing files, another number of values, text that is not a number, infinities, values beyond the
+// float range, a partly NaN line and a negative size throw roiflow::Error as `path:line: what was
+// wrong`.
 std::vector<cv::Rect2f> read_ground_truth(const std::string& path);
 // The same from a file's text held in memory; `name` stands for the path in error messages.
 std::vector<cv::Rect2f> parse_ground_truth(std::string_view text, const std::string& name);
@@ -61,6 +64,22 @@ std::vector<cv::Rect2f> track_boxes(const std::vector<TrackRecord>& records);
 
 // Throws roiflow::Error, naming both lengths, when no frame is left to score.
 OtbScore score(const std::vector<cv::Rect2f>& track, const std::vector<cv::Rect2f>& truth);
+
+// The curves of OTB's success and precision plots for one track, over the frames score()
+// scores: success[k] is the share of frames with IoU > k / 20 (k = 0..20; their mean is the AUC),
+// precision[t] the share with a centre error <= t px (t = 0..50; precision[20] is
+// precision@20). Throws like score(). Averaging the curves of several sequences gives the plots
+// of a whole benchmark (OTB's perfPlot.m averages per sequence too).
+constexpr int kSuccessThresholds = 21;
+constexpr int kPrecisionThresholds = 51;
+struct OtbCurves {
+  std::vector<double> success;    // kSuccessThresholds values
+  std::vector<double> precision;  // kPrecisionThresholds values
+  long long frames = 0;           // frames scored
+};
+OtbCurves otb_curves(const std::vector<cv::Rect2f>& track, const std::vector<cv::Rect2f>& truth);
+// The area under a success curve: the mean of its values (0 for an empty curve).
+double curve_auc(const std::vector<double>& success);
 
 // 0 when either box is empty (zero or negative size) or not finite.
 double iou(const cv::Rect2f& a, const cv::Rect2f& b);

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "eval/scene_parts.hpp"
 
 namespace roiflow::eval {
 namespace {
@@ -20,6 +21,10 @@ std::string num(double v) {
   return s.str();
 }
 
+}  // namespace
+
+namespace detail {
+
 // splitmix64, so that seeds 1, 2, 3... and the per-frame noise streams are unrelated.
 std::uint64_t mix(std::uint64_t seed, std::uint64_t stream) {
   std::uint64_t z = seed + 0x9E3779B97F4A7C15ull * (stream + 1);
@@ -27,6 +32,8 @@ std::uint64_t mix(std::uint64_t seed, std::uint64_t stream) {
   z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
   return z ^ (z >> 31);
 }
+
+namespace {
 
 // Smoothed uniform noise in [-1, 1] with features about `cell` pixels wide.
 cv::Mat smooth_noise(cv::RNG& rng, cv::Size size, int cell) {
@@ -36,6 +43,8 @@ cv::Mat smooth_noise(cv::RNG& rng, cv::Size size, int cell) {
   cv::resize(grid, out, size, 0, 0, cv::INTER_CUBIC);
   return out;
 }
+
+}  // namespace
 
 // Adds gray noise octaves of the given cell sizes, amplitude growing with the cell (a 1/f-like
 // spectrum, as in natural images), each with a slight colour tint.
@@ -103,6 +112,14 @@ cv::Mat rounded_rect_alpha(cv::Size size, double r) {
   }
   return alpha;
 }
+
+}  // namespace detail
+
+namespace {
+
+using detail::add_octaves;
+using detail::mix;
+using detail::rounded_rect_alpha;
 
 // A vehicle seen from above or the side: a saturated body with fine texture, a light stripe,
 // dark windows and a dark rim, so it differs from the muted background in colour and texture.
@@ -197,7 +214,7 @@ TrackingScene::TrackingScene(const TrackingSceneParams& params) : params_(params
   }
 
   cv::RNG bg_rng(mix(params_.seed, 0));
-  background_ = draw_background(params_.size, bg_rng);
+  background_ = detail::draw_background(params_.size, bg_rng);
   cv::RNG vehicle_rng(mix(params_.seed, 1));
   const cv::Size tex(static_cast<int>(std::ceil(max_w)), static_cast<int>(std::ceil(max_h)));
   alpha_ = rounded_rect_alpha(tex, 0.22 * std::min(tex.width, tex.height));

@@ -19,7 +19,9 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "eval/synthetic_input.hpp"
 #include "eval/tracking_scene.hpp"
+#include "eval/traffic_scene.hpp"
 #include "stages/video_decoder.hpp"
 
 namespace roiflow::stages {
@@ -382,35 +384,34 @@ class SyntheticReader : public VideoSource::Reader {
   }
 };
 
-constexpr std::string_view kSyntheticPrefix = "synthetic:";
+// "synthetic:N[:WxH]:OBJECTS": eval::TrafficScene, N frames, its vehicles' boxes known exactly.
+class TrafficReader : public VideoSource::Reader {
+ public:
+  TrafficReader(const eval::TrafficSceneParams& params, double fps) : fps_(fps), scene_(params) {}
+
+  bool read(long long index, Frame& frame, std::string&) override {
+    if (index >= scene_.frames()) return false;
+    frame.image = scene_.render(index);
+    frame.timestamp_s = static_cast<double>(index) / fps_;
+    return true;
+  }
+
+  double fps() const override { return fps_; }
+  long long frame_count() const override { return scene_.frames(); }
+  std::string description() const override {
+    return "synthetic traffic (" + std::to_string(scene_.frames()) + " frames, " +
+           std::to_string(scene_.objects()) + " vehicles, " + number_string(fps_) + " fps)";
+  }
+
+ private:
+  double fps_;
+  eval::TrafficScene scene_;
+};
 
 std::unique_ptr<VideoSource::Reader> open_synthetic(const std::string& input, double fps) {
-  const auto bad = [&](const std::string& why) {
-    return Error("bad synthetic input " + quoted(input) + ": " + why +
-                 " (expected synthetic:N or synthetic:N:WxH, like synthetic:1000:640x480)");
-  };
-  std::string_view spec = std::string_view(input).substr(kSyntheticPrefix.size());
-  const auto colon = spec.find(':');
-  const std::string_view count_text = spec.substr(0, colon);
-  const auto count = all_digits(count_text) ? parse_number(count_text) : std::nullopt;
-  if (!count || *count < 1 || *count > 1'000'000'000)
-    throw bad("the frame count must be in 1..1000000000");
-  cv::Size size(640, 480);
-  if (colon != std::string_view::npos) {
-    const std::string_view size_text = spec.substr(colon + 1);
-    const auto x = size_text.find('x');
-    const std::string_view w = size_text.substr(0, x);
-    const std::string_view h = x == std::string_view::npos ? "" : size_text.substr(x + 1);
-    const auto width = all_digits(w) ? parse_number(w) : std::nullopt;
-    const auto height = all_digits(h) ? parse_number(h) : std::nullopt;
-    if (!width || !height || *width < 64 || *height < 64 || *width > eval::kMaxFrameSide ||
-        *height > eval::kMaxFrameSide)
-      throw bad("the size must be WxH with each side in 64.." +
-                std::to_string(eval::kMaxFrameSide));
-    size = {static_cast<int>(*width), static_cast<int>(*height)};
-    eval::check_frame_size(size, "synthetic input " + quoted(input));
-  }
-  return std::make_unique<SyntheticReader>(*count, size, fps);
+  const eval::SyntheticInput spec = eval::parse_synthetic_input(input);
+  if (spec.objects > 0) return std::make_unique<TrafficReader>(eval::traffic_params(spec), fps);
+  return std::make_unique<SyntheticReader>(spec.frames, spec.size, fps);
 }
 
 // The camera index that `input` names, or -1 when it is not one.
@@ -440,7 +441,7 @@ std::unique_ptr<VideoSource::Reader> open_reader(const std::string& input, doubl
   }
   if (fs::exists(status))
     return std::make_unique<VideoFileReader>(input, fps, decode_threads, defer_colour);
-  if (input.starts_with(kSyntheticPrefix)) return open_synthetic(input, fps);
+  if (eval::is_synthetic_input(input)) return open_synthetic(input, fps);
   if (input.find('%') != std::string::npos) {
     const Pattern pattern = parse_pattern(input);
     const Numbered numbered = find_pattern_files(pattern);

@@ -25,6 +25,9 @@
 //     frames long and plays forwards, then backwards, then forwards again (frame i shows scene
 //     frame i mod 598, mirrored past 299), so a stream of any length holds one scene and one
 //     frame at a time: the input of soak runs.
+//   - "synthetic:N[:WxH]:OBJECTS": N frames of eval::TrafficScene, OBJECTS (1..256) vehicles
+//     crossing, entering and leaving, whose exact boxes eval::TrafficScene::ground_truth()
+//     gives (eval/synthetic_input.hpp parses the spec).
 //
 // Frame size limits: every frame must be at most kMaxFrameSide pixels a side and kMaxFramePixels
 // pixels in all (8K UHD, 7680x4320, fits), and at least kMinFrameSide a side (the smallest
