@@ -195,8 +195,7 @@ struct EvalCommand {
 };
 
 // `skipped` receives what a partial tree lacks (see eval::find_pairs).
-std::vector<eval::EvalPair> eval_pairs(const EvalCommand& cmd,
-                                         std::vector<std::string>& skipped) {
+std::vector<eval::EvalPair> eval_pairs(const EvalCommand& cmd, std::vector<std::string>& skipped) {
   if (cmd.dir.empty() && cmd.pairs.empty()) {
     throw UsageError(
         "eval needs a Middlebury, Sintel or KITTI directory DIR or at least one --pair A B GT");
@@ -428,6 +427,7 @@ int main(int argc, char** argv) {
   add_sweep_command(app);
   add_scaling_command(app);
   add_benchmark_command(app);
+  add_motion_check_command(app, exit_code);
 
   try {
     app.parse(argc, argv);

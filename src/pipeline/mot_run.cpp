@@ -1,10 +1,9 @@
 #include "pipeline/mot_run.hpp"
 
-#include <cstdio>
 #include <iostream>
 #include <optional>
 
-#include "core/atomic_write.hpp"
+#include "eval/mot.hpp"
 #include "report/annotate.hpp"
 #include "report/progress.hpp"
 #include "report/run_stats.hpp"
@@ -32,12 +31,13 @@ report::ObjectsAnnotation annotation(const stages::MotFrame& f) {
 
 }  // namespace
 
-std::string mot_row(long long index, const stages::TrackedObject& o, double conf) {
-  char buffer[160];
-  std::snprintf(buffer, sizeof buffer, "%lld,%lld,%.2f,%.2f,%.2f,%.2f,%.3g,-1,-1,-1\n", index + 1,
-                o.id, o.box.x + 1.0, o.box.y + 1.0, static_cast<double>(o.box.width),
-                static_cast<double>(o.box.height), conf);
-  return buffer;
+eval::MotBox mot_box(long long index, const stages::TrackedObject& o) {
+  eval::MotBox b;
+  b.frame = static_cast<int>(index + 1);
+  b.id = static_cast<int>(o.id);
+  b.box = cv::Rect2d(o.box.x + 1.0, o.box.y + 1.0, o.box.width, o.box.height);
+  b.conf = 1;
+  return b;
 }
 
 MotRun track_objects(const FrameSource& source, cv::Size size, double fps,
@@ -50,7 +50,7 @@ MotRun track_objects(const FrameSource& source, cv::Size size, double fps,
   report::Progress progress(std::cerr, options.frame_hint,
                             options.progress && report::Progress::stderr_is_terminal());
 
-  std::string mot_text;
+  std::vector<eval::MotBox> mot_boxes;
   long long lost_records = 0, object_frames = 0, most_objects = 0;
   stages::MotFrame last;
   std::vector<MotSink> sinks;
@@ -61,7 +61,7 @@ MotRun track_objects(const FrameSource& source, cv::Size size, double fps,
                          ++lost_records;
                        } else {
                          ++found;
-                         if (!options.mot.empty()) mot_text += mot_row(f.output->index, o);
+                         if (!options.mot.empty()) mot_boxes.push_back(mot_box(f.output->index, o));
                        }
                        if (log) {
                          eval::TrackRecord r;
@@ -99,7 +99,7 @@ MotRun track_objects(const FrameSource& source, cv::Size size, double fps,
   progress.finish();
   if (log) log->close();
   if (video) video->close();
-  if (!options.mot.empty()) write_text_atomically(options.mot, mot_text);
+  if (!options.mot.empty()) eval::write_mot(options.mot, mot_boxes);
 
   const nlohmann::ordered_json s = stats.to_json(run.report.wall_s);
   double tracker_ms = 0;

@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "eval/mot.hpp"
 #include "pipeline/frame_graph.hpp"
 #include "stages/multi_tracker.hpp"
 
@@ -50,7 +51,8 @@ struct MotRun {
 MotRun track_objects(const FrameSource& source, cv::Size size, double fps,
                      const MotRunOptions& options);
 
-// One MOTChallenge line for an object of frame `index` (0-based): "frame,id,x,y,w,h,conf,-1,-1,-1".
-std::string mot_row(long long index, const stages::TrackedObject& object, double conf = 1.0);
+// An object of frame `index` (0-based) as a MOTChallenge box: frame index + 1, the top-left
+// corner plus one (MOTChallenge counts pixels from 1), confidence 1 (eval::write_mot writes it).
+eval::MotBox mot_box(long long index, const stages::TrackedObject& object);
 
 }  // namespace roiflow::pipeline

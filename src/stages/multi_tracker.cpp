@@ -11,6 +11,7 @@
 #include <limits>
 #include <string>
 
+#include "core/assignment.hpp"
 #include "core/error.hpp"
 #include "core/text.hpp"
 #include "core/text_file.hpp"
@@ -228,73 +229,6 @@ cv::Point2f BoxFilter::velocity() const {
   return {static_cast<float>(x[4]), static_cast<float>(x[5])};
 }
 
-// ---------------------------------------------------------------------------------- assignment
-
-std::vector<int> assign_min_cost(const cv::Mat_<double>& cost, double forbidden) {
-  const int rows = cost.rows, cols = cost.cols;
-  std::vector<int> out(static_cast<std::size_t>(rows), -1);
-  if (rows == 0 || cols == 0) return out;
-  const bool transposed = rows > cols;
-  const int n = transposed ? cols : rows, m = transposed ? rows : cols;
-  double big = 1;
-  for (int r = 0; r < rows; ++r)
-    for (int c = 0; c < cols; ++c)
-      if (cost(r, c) < forbidden) big = std::max(big, std::abs(cost(r, c)));
-  big = big * (n + 1) * 4;
-  auto a = [&](int i, int j) {  // 1-based, n <= m
-    const double v = transposed ? cost(j - 1, i - 1) : cost(i - 1, j - 1);
-    return v >= forbidden ? big : v;
-  };
-  // Shortest augmenting paths with potentials (e-maxx's O(n^2 m) Hungarian).
-  const double inf = std::numeric_limits<double>::infinity();
-  std::vector<double> u(static_cast<std::size_t>(n) + 1), v(static_cast<std::size_t>(m) + 1);
-  std::vector<int> p(static_cast<std::size_t>(m) + 1), way(static_cast<std::size_t>(m) + 1);
-  for (int i = 1; i <= n; ++i) {
-    p[0] = i;
-    int j0 = 0;
-    std::vector<double> minv(static_cast<std::size_t>(m) + 1, inf);
-    std::vector<char> used(static_cast<std::size_t>(m) + 1, 0);
-    do {
-      used[j0] = 1;
-      const int i0 = p[j0];
-      double delta = inf;
-      int j1 = 0;
-      for (int j = 1; j <= m; ++j) {
-        if (used[j]) continue;
-        const double cur = a(i0, j) - u[i0] - v[j];
-        if (cur < minv[j]) {
-          minv[j] = cur;
-          way[j] = j0;
-        }
-        if (minv[j] < delta) {
-          delta = minv[j];
-          j1 = j;
-        }
-      }
-      for (int j = 0; j <= m; ++j) {
-        if (used[j]) {
-          u[p[j]] += delta;
-          v[j] -= delta;
-        } else {
-          minv[j] -= delta;
-        }
-      }
-      j0 = j1;
-    } while (p[j0] != 0);
-    do {
-      const int j1 = way[j0];
-      p[j0] = p[j1];
-      j0 = j1;
-    } while (j0 != 0);
-  }
-  for (int j = 1; j <= m; ++j) {
-    if (p[j] == 0) continue;
-    const int r = transposed ? j - 1 : p[j] - 1, c = transposed ? p[j] - 1 : j - 1;
-    if (cost(r, c) < forbidden) out[static_cast<std::size_t>(r)] = c;
-  }
-  return out;
-}
-
 // ---------------------------------------------------------------------------------- the steps
 
 TrackSet initial_tracks(const MultiTrackerParams& params) {
@@ -483,8 +417,8 @@ TrackSet decide(const TrackSet& previous, long long index, cv::Size size,
     if (!in_merge[i]) rows.push_back(i);
   for (std::size_t j = 0; j < nd; ++j)
     if (!merged[j]) cols.push_back(j);
-  constexpr double kForbidden = 1e9;
-  cv::Mat_<double> cost(static_cast<int>(rows.size()), static_cast<int>(cols.size()));
+  const double kForbidden = std::numeric_limits<double>::infinity();
+  std::vector<double> cost(rows.size() * cols.size(), kForbidden);
   for (std::size_t r = 0; r < rows.size(); ++r) {
     for (std::size_t c = 0; c < cols.size(); ++c) {
       const double o = iou(guess[rows[r]], detections[cols[c]].box);
@@ -494,10 +428,12 @@ TrackSet decide(const TrackSet& previous, long long index, cv::Size size,
       // may hold it as a ghost).
       const double gate =
           s.tracks[rows[r]].known ? std::max(0.5, params.gate_iou) : params.gate_iou;
-      cost(static_cast<int>(r), static_cast<int>(c)) = o > gate ? 1.0 - o + tentative : kForbidden;
+      if (o > gate) cost[r * cols.size() + c] = 1.0 - o + tentative;
     }
   }
-  const std::vector<int> match = assign_min_cost(cost, kForbidden);
+  const Assignment assigned =
+      solve_assignment(cost, static_cast<int>(rows.size()), static_cast<int>(cols.size()));
+  const std::vector<int>& match = assigned.row_to_col;
   std::vector<int> det_of(n, -1);
   std::vector<char> det_used(nd, 0);
   for (std::size_t r = 0; r < rows.size(); ++r) {

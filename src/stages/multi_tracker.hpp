@@ -19,10 +19,10 @@
 //  - decide(state at t, the frame's tile motions, foreground, detections) -> state at t+1: per
 //    object a constant-velocity Kalman filter on its box (centre, size and their velocities; the
 //    paper's Fig. 3 correction), predicted, then corrected by the detection the optimal
-//    assignment gives it (cost 1 - IoU with where LK or the prediction puts it), or, where
-//    background-subtraction blobs merge (one blob over several objects) or no detection is
-//    left, by its LK motion as long as its box holds moving pixels. Births: detections no
-//    object explains, confirmed after `min_hits` consecutive frames, found on global frames
+//    assignment (core/assignment.hpp) gives it (cost 1 - IoU with where LK or the prediction puts
+//    it), or, where background-subtraction blobs merge (one blob over several objects) or no
+//    detection is left, by its LK motion as long as its box holds moving pixels. Births: detections
+//    no object explains, confirmed after `min_hits` consecutive frames, found on global frames
 //    (every `global_interval` frames and whenever an object is lost). Deaths: lost for
 //    `max_lost` frames, no moving pixels for `still_frames` frames, less than `min_visible` of
 //    the box inside the frame, or a side under `min_side` pixels; an object that duplicates an
@@ -169,10 +169,6 @@ TrackSet decide(const TrackSet& state, long long index, cv::Size size,
 // The sinks' view of a decided state.
 MotFrame report_frame(const TrackSet& state, const std::vector<TileMotion>& motions,
                       bool global_frame);
-
-// Minimal-cost assignment of rows to columns (Hungarian / Jonker-Volgenant); entries >=
-// `forbidden` are never assigned. Returns, per row, the column or -1.
-std::vector<int> assign_min_cost(const cv::Mat_<double>& cost, double forbidden);
 
 // The four steps in order, serially, for one frame at a time.
 class MultiTracker {

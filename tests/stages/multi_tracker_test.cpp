@@ -19,61 +19,6 @@ using stages::MultiTrackerParams;
 using test::MotObject;
 using test::MotScene;
 
-TEST(AssignMinCost, FindsTheOptimumWhereGreedyDoesNot) {
-  // Greedy takes (0,0) = 1 first and then must pay 10 for (1,1); the optimum is 2 + 3.
-  cv::Mat_<double> cost(2, 2);
-  cost << 1, 2, 3, 10;
-  EXPECT_EQ(stages::assign_min_cost(cost, 1e9), (std::vector<int>{1, 0}));
-}
-
-TEST(AssignMinCost, RectangularAndForbidden) {
-  cv::Mat_<double> wide(2, 3);
-  wide << 5, 1, 9, 1, 5, 9;
-  EXPECT_EQ(stages::assign_min_cost(wide, 1e9), (std::vector<int>{1, 0}));
-  cv::Mat_<double> tall(3, 2);
-  tall << 5, 1, 1, 5, 0.5, 0.5;
-  const std::vector<int> t = stages::assign_min_cost(tall, 1e9);
-  EXPECT_EQ(t, (std::vector<int>{1, -1, 0}));  // 1 + 0.5 beats 1 + 1
-  cv::Mat_<double> forbidden(2, 2);
-  forbidden << 1e9, 1e9, 1e9, 2;
-  EXPECT_EQ(stages::assign_min_cost(forbidden, 1e9), (std::vector<int>{-1, 1}));
-  EXPECT_TRUE(stages::assign_min_cost(cv::Mat_<double>(0, 3), 1e9).empty());
-  EXPECT_EQ(stages::assign_min_cost(cv::Mat_<double>(2, 0), 1e9), (std::vector<int>{-1, -1}));
-}
-
-TEST(AssignMinCost, MatchesBruteForceOnRandomMatrices) {
-  cv::RNG rng(3);
-  for (int trial = 0; trial < 200; ++trial) {
-    const int n = 1 + trial % 5, m = 1 + (trial / 5) % 5;
-    cv::Mat_<double> c(n, m);
-    rng.fill(c, cv::RNG::UNIFORM, 0.0, 1.0);
-    const std::vector<int> a = stages::assign_min_cost(c, 1e9);
-    double got = 0;
-    std::set<int> used;
-    for (int r = 0; r < n; ++r) {
-      ASSERT_GE(a[static_cast<std::size_t>(r)], n <= m ? 0 : -1);
-      if (a[static_cast<std::size_t>(r)] >= 0) {
-        got += c(r, a[static_cast<std::size_t>(r)]);
-        EXPECT_TRUE(used.insert(a[static_cast<std::size_t>(r)]).second);
-      }
-    }
-    EXPECT_EQ(static_cast<int>(used.size()), std::min(n, m));
-    // Brute force over the permutations of the larger side.
-    std::vector<int> idx(static_cast<std::size_t>(std::max(n, m)));
-    for (std::size_t i = 0; i < idx.size(); ++i)
-      idx[i] = static_cast<int>(i);
-    double best = 1e18;
-    do {
-      double s = 0;
-      for (int k = 0; k < std::min(n, m); ++k)
-        s += n <= m ? c(k, idx[static_cast<std::size_t>(k)])
-                    : c(idx[static_cast<std::size_t>(k)], k);
-      best = std::min(best, s);
-    } while (std::next_permutation(idx.begin(), idx.end()));
-    EXPECT_NEAR(got, best, 1e-9) << n << "x" << m;
-  }
-}
-
 TEST(BoxFilter, LearnsAConstantVelocity) {
   stages::BoxFilter f = stages::BoxFilter::start({100, 50, 20, 40});
   for (int t = 1; t <= 20; ++t) {

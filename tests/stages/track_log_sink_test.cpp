@@ -100,8 +100,8 @@ TEST_F(TrackLogTest, JsonIsValidAfterEveryRecord) {
   for (const auto& item : doc[1].items())
     keys.push_back(item.key());
   std::sort(keys.begin(), keys.end());
-  EXPECT_EQ(keys, (std::vector<std::string>{"frame", "h", "lost", "mode", "ms", "vx", "vy", "w",
-                                            "x", "y"}));
+  EXPECT_EQ(keys, (std::vector<std::string>{"frame", "h", "id", "lost", "mode", "ms", "vx", "vy",
+                                            "w", "x", "y"}));
   EXPECT_EQ(doc[1]["frame"], 2);
   EXPECT_TRUE(doc[1]["frame"].is_number_integer());
   EXPECT_EQ(doc[1]["mode"], "local");
