@@ -138,7 +138,9 @@ void run_flow(const FlowCommand& cmd) {
   std::string written = cmd.output;
   eval::write_flo(cmd.output, result.flow);
   if (!cmd.color.empty()) {
-    eval::write_image_atomically(cmd.color, flow::flow_to_color(result.flow));
+    // Against a ground truth, the truth's largest vector saturates, so the two pictures compare.
+    const float scale = truth.empty() ? -1.f : flow::max_magnitude(truth);
+    eval::write_image_atomically(cmd.color, flow::flow_to_color(result.flow, scale));
     written += ", " + cmd.color;
   }
   if (!cmd.legend.empty()) {
@@ -169,7 +171,10 @@ void add_flow_command(CLI::App& app, FlowCommand& cmd) {
   sub->add_option("-o,--output", cmd.output, "the flow, Middlebury .flo")
       ->type_name("FLO")
       ->required();
-  sub->add_option("--color", cmd.color, "the flow in Middlebury colour coding")->type_name("IMAGE");
+  sub->add_option("--color", cmd.color,
+                  "the flow in Middlebury colour coding, saturated at the 99th percentile of its "
+                  "magnitudes (with --gt: at the truth's largest)")
+      ->type_name("IMAGE");
   sub->add_option("--legend", cmd.legend, "the colour wheel, as a legend")->type_name("IMAGE");
   sub->add_option("--gt", cmd.ground_truth, "ground-truth flow: print the error against it")
       ->type_name("FLO");

@@ -28,6 +28,7 @@
 #include "eval/track_log.hpp"
 #include "eval/tracking_scene.hpp"
 #include "flow/color_code.hpp"
+#include "pipeline/dense_outputs.hpp"
 #include "pipeline/frame_graph.hpp"
 #include "pipeline/mot_run.hpp"
 #include "pipeline/tbb_executor.hpp"
@@ -926,20 +927,31 @@ struct DenseCommand {
   std::string input;
   RunOutputs out;
   double max_motion = 0;
+  std::string flow_out;
+  std::string flow_format = "flo";
   SourceOptions source;
 };
 
 int run_dense(const DenseCommand& cmd) {
   const flow::LkParams params = lk_params(cmd.lk);
-  if (cmd.out.video.empty()) throw UsageError("dense needs --out VIDEO|DIR");
-  check_output_path(cmd.out.video, "--out");
+  if (cmd.out.video.empty() && cmd.flow_out.empty()) {
+    throw UsageError("dense needs --out VIDEO|DIR or --flow-out DIR");
+  }
+  if (!cmd.out.video.empty()) check_output_path(cmd.out.video, "--out");
   if (!cmd.out.summary.empty()) check_summary_path(cmd.out.summary);
 
   stages::VideoSource source(cmd.input, cmd.source.params());
-  stages::VideoSink video(cmd.out.video, source.fps(), source.size());
+  pipeline::DenseOutputOptions outputs_wanted;
+  outputs_wanted.video = cmd.out.video;
+  outputs_wanted.flow_dir = cmd.flow_out;
+  outputs_wanted.flow_format = stages::flow_file_format_from_string(cmd.flow_format);
+  outputs_wanted.max_motion = cmd.max_motion;
+  pipeline::DenseOutputs outputs(outputs_wanted, source.fps(), source.size());
+  std::vector<pipeline::FlowSink> sinks = outputs.sinks();
   const long long hint = source.frame_count_hint();
   report::Progress progress(std::cerr, hint > 1 ? hint - 1 : hint,
                             cmd.out.progress && report::Progress::stderr_is_terminal());
+  sinks.push_back({"progress", [&](const pipeline::FlowPair& p) { progress.update(p.seq + 1); }});
 
   SignalScope signals;
   report::RunStats stats;
@@ -948,17 +960,10 @@ int run_dense(const DenseCommand& cmd) {
   options.max_in_flight = cmd.source.in_flight;
   options.cancel = &g_cancel;
   options.stats = &stats;
-  const float max_motion = static_cast<float>(cmd.max_motion > 0 ? cmd.max_motion : -1.0);
-  const pipeline::RunReport report = pipeline::run_dense(
-      [&] { return source.next(); }, params,
-      {{"video",
-        [&](const pipeline::FlowPair& p) {
-          video.write(flow::flow_to_color(p.flow->flow, max_motion));
-        }},
-       {"progress", [&](const pipeline::FlowPair& p) { progress.update(p.seq + 1); }}},
-      options);
+  const pipeline::RunReport report =
+      pipeline::run_dense([&] { return source.next(); }, params, sinks, options);
   progress.finish();
-  video.close();
+  outputs.close();
 
   const Ending end = ending(report, &source.status());
   const nlohmann::ordered_json s = stats.to_json(report.wall_s);
@@ -977,7 +982,7 @@ int run_dense(const DenseCommand& cmd) {
       {"status", end.message.empty() ? source.status().message : end.message},
       {"peak_rss_mb", report::peak_rss_mb()},
       {"stages", s.at("stages")}};
-  std::string written = cmd.out.video;
+  std::string written = outputs.description();
   if (!cmd.out.summary.empty()) {
     write_text_atomically(cmd.out.summary, summary.dump(2) + "\n");
     written += ", " + cmd.out.summary;
@@ -997,8 +1002,16 @@ void add_dense_command(CLI::App& app, DenseCommand& cmd, int& exit_code) {
   add_run_outputs(*sub, cmd.out,
                   "the colour-coded flow: a video (.mp4 .avi .mkv .mov) or a folder of PNGs");
   sub->add_option("--max-motion", cmd.max_motion,
-                  "flow magnitude (px) at full colour saturation; 0 = each pair's own maximum")
+                  "flow magnitude (px) at full colour saturation; 0 = each pair's own robust "
+                  "maximum (the 99th percentile of its magnitudes)")
       ->check(CLI::Range(0.0, 1e4));
+  sub->add_option("--flow-out", cmd.flow_out,
+                  "folder for the raw flow of every pair (000001.flo/.png: frame 1 -> 2)")
+      ->type_name("DIR");
+  sub->add_option("--flow-format", cmd.flow_format,
+                  "raw flow files: flo (Middlebury, float) or kitti (16-bit PNG, 1/64 px)")
+      ->check(CLI::IsMember({"flo", "kitti"}))
+      ->capture_default_str();
   add_source_options(*sub, cmd.source);
   cmd.lk.threads = default_threads();
   add_lk_options(*sub, cmd.lk);

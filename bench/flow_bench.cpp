@@ -5,6 +5,8 @@
 //
 //   BM_Flow/<method>/<W>x<H>/threads:<n>   method: roiflow_paper, roiflow_accurate, roiflow_fast,
 //                                          dis_ultrafast, dis_fast, dis_medium, farneback
+//   BM_TwoThreadBound/<paper|fast>/<W>x<H>  one pair's two-thread schedule timed on the CPU clock
+//                                          of one thread: speedup2, what two idle cores would give
 //   BM_Pyramid/<W>x<H>                     build_pyramid(frame) alone (paper preset), 1 thread
 //   BM_Pretreatment/<roiflow|opencv>/<W>x<H>  level 0 alone (sigma 0.5): roiflow's fused pass vs
 //                                          OpenCV's convertTo + GaussianBlur, 1 thread
@@ -29,6 +31,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -177,6 +180,77 @@ void bm_pretreatment(benchmark::State& state, cv::Size size, bool opencv) {
   });
 }
 
+// The two-thread schedule of one pair, run on one thread and timed on its CPU clock, so that a
+// loaded machine (other processes on the cores) cannot blur it: every for_range region of a
+// `lanes`-thread executor (the two pyramids, the row bands of each level, the result copy) runs
+// its chunks one after the other, and the region is charged what `lanes` threads would take at
+// best, max(longest chunk, sum / lanes); the serial rest is charged as it is. Sync and memory
+// contention between the threads are not in it: it is the bound a quiet machine approaches.
+class CriticalPathExecutor final : public roiflow::Executor {
+ public:
+  explicit CriticalPathExecutor(int lanes) : lanes_(lanes) {}
+  void for_range(int begin, int end, int grain,
+                 const std::function<void(int, int)>& body) const override {
+    const int step = std::max(1, grain);
+    double sum = 0, longest = 0;
+    for (int b = begin; b < end; b += step) {
+      const double t0 = thread_cpu_s();
+      body(b, std::min(end, b + step));
+      const double t = thread_cpu_s() - t0;
+      sum += t;
+      longest = std::max(longest, t);
+    }
+    saved_s_ += sum - std::max(longest, sum / lanes_);
+  }
+  int concurrency() const override { return lanes_; }
+  // CPU seconds the schedule would not take on `lanes` threads, since the last reset.
+  double saved_s() const { return saved_s_; }
+  void reset() { saved_s_ = 0; }
+
+  static double thread_cpu_s() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+  }
+
+ private:
+  int lanes_;
+  mutable double saved_s_ = 0;
+};
+
+// BM_TwoThreadBound/<preset>/<W>x<H>: counters t1_ms (one pair on one thread, CPU time),
+// work2_ms (the two-thread schedule's total CPU time: its bands recompute some rows),
+// critical2_ms (what two threads would take, see CriticalPathExecutor) and speedup2 = t1_ms /
+// critical2_ms.
+void bm_two_thread_bound(benchmark::State& state, roiflow::flow::LkParams params, cv::Size size) {
+  const Scene& scene = scene_of(size);
+  roiflow::pipeline::run_with_threads(1, [&] {
+    CriticalPathExecutor two(2);
+    roiflow::flow::DenseLK serial(params), split(params, &two);
+    roiflow::flow::FlowResult a, b;
+    serial.calc(scene.frame0, scene.frame1, a);
+    split.calc(scene.frame0, scene.frame1, b);
+    double t1 = 0, work2 = 0, critical2 = 0;
+    for (auto _ : state) {
+      double t0 = CriticalPathExecutor::thread_cpu_s();
+      serial.calc(scene.frame0, scene.frame1, a);
+      t1 += CriticalPathExecutor::thread_cpu_s() - t0;
+      two.reset();
+      t0 = CriticalPathExecutor::thread_cpu_s();
+      split.calc(scene.frame0, scene.frame1, b);
+      const double w = CriticalPathExecutor::thread_cpu_s() - t0;
+      work2 += w;
+      critical2 += w - two.saved_s();
+    }
+    if (cv::norm(a.flow, b.flow, cv::NORM_INF) != 0.0) state.SkipWithError("flows differ");
+    const double n = static_cast<double>(state.iterations());
+    state.counters["t1_ms"] = 1e3 * t1 / n;
+    state.counters["work2_ms"] = 1e3 * work2 / n;
+    state.counters["critical2_ms"] = 1e3 * critical2 / n;
+    state.counters["speedup2"] = t1 / critical2;
+  });
+}
+
 // Real data with ground truth: a dataset's pairs as scenes (frames, ground-truth flow), with the
 // pixels its tree says not to score (Sintel's invalid masks), as `roiflow eval` reads them.
 struct Dataset {
@@ -276,6 +350,12 @@ void register_benchmarks() {
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();
       }
+    }
+    for (const char* preset : {"paper", "fast"}) {
+      benchmark::RegisterBenchmark(
+          ("BM_TwoThreadBound/" + std::string(preset) + "/" + size_name(size)).c_str(),
+          bm_two_thread_bound, roiflow::flow::LkParams::preset(preset), size)
+          ->Unit(benchmark::kMillisecond);
     }
     benchmark::RegisterBenchmark(("BM_Pyramid/" + size_name(size)).c_str(), bm_pyramid, size)
         ->Unit(benchmark::kMillisecond)

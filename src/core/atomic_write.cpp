@@ -50,4 +50,14 @@ void write_text_atomically(const std::string& path, const std::string& text) {
   });
 }
 
+void write_bytes_atomically(const std::string& path, const std::string& what, const void* data,
+                            std::size_t size) {
+  write_atomically(path, what, [&](const std::string& partial) {
+    std::ofstream out(partial, std::ios::binary);
+    out.write(static_cast<const char*>(data), static_cast<std::streamsize>(size));
+    out.close();
+    return static_cast<bool>(out);
+  });
+}
+
 }  // namespace roiflow

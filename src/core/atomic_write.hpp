@@ -18,6 +18,7 @@
 // file is removed.
 #pragma once
 
+#include <cstddef>
 #include <functional>
 #include <opencv2/core.hpp>
 #include <string>
@@ -31,5 +32,8 @@ void write_atomically(const std::string& path, const std::string& what,
                       const std::function<bool(const std::string& partial_path)>& write);
 
 void write_text_atomically(const std::string& path, const std::string& text);
+// `size` bytes from `data` (e.g. an image encoded in memory by cv::imencode).
+void write_bytes_atomically(const std::string& path, const std::string& what, const void* data,
+                            std::size_t size);
 
 }  // namespace roiflow

@@ -58,7 +58,7 @@ cv::Mat read_kitti_flow(const std::string& path) {
   }
 }
 
-cv::Mat encode_kitti_flow(const cv::Mat& flow) {
+cv::Mat encode_kitti_flow(const cv::Mat& flow, bool out_of_range_invalid) {
   if (flow.empty() || flow.type() != CV_32FC2) {
     throw Error("encode_kitti_flow: flow must be non-empty CV_32FC2, got " + describe(flow));
   }
@@ -78,6 +78,10 @@ cv::Mat encode_kitti_flow(const cv::Mat& flow) {
       const double ru = std::round(u * kScale) + kOffset;
       const double rv = std::round(v * kScale) + kOffset;
       if (ru < 0 || ru > 65535 || rv < 0 || rv > 65535) {
+        if (out_of_range_invalid) {
+          bgr[0] = bgr[1] = bgr[2] = 0;
+          continue;
+        }
         throw Error("encode_kitti_flow: flow (" + number_text(u) + ", " + number_text(v) +
                     ") at (" + std::to_string(x) + "," + std::to_string(y) +
                     ") is outside the KITTI range [-512, 511.984375]");

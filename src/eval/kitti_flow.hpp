@@ -29,8 +29,10 @@ cv::Mat read_kitti_flow(const std::string& path);
 
 // CV_16UC3 (B G R) for cv::imwrite; unknown flow is written invalid (all three zero), known flow
 // is rounded to 1/64 px. Throws roiflow::Error when `flow` is not CV_32FC2 or a known value is
-// outside [-512, 512 - 1/64] (the encoding cannot hold it; clamping would be a silent lie).
-cv::Mat encode_kitti_flow(const cv::Mat& flow);
+// outside [-512, 512 - 1/64] (the encoding cannot hold it; clamping would be a silent lie),
+// unless `out_of_range_invalid`: such a vector is then written invalid, as unknown flow is (a
+// video's per-pair output keeps going past one wild vector).
+cv::Mat encode_kitti_flow(const cv::Mat& flow, bool out_of_range_invalid = false);
 // Encodes and writes `path` (.png) atomically.
 void write_kitti_flow(const std::string& path, const cv::Mat& flow);
 

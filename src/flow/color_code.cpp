@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -40,6 +41,18 @@ constexpr std::array<Rgb, kWheelSize> make_wheel() {
 
 constexpr std::array<Rgb, kWheelSize> kWheel = make_wheel();
 
+// The wheel in [0, 1], each entry exactly static_cast<float>(channel) / 255.f as computed per
+// pixel before, looked up instead of divided.
+using RgbF = std::array<float, 3>;
+const std::array<RgbF, kWheelSize> kWheelF = [] {
+  std::array<RgbF, kWheelSize> w{};
+  for (int k = 0; k < kWheelSize; ++k) {
+    for (int c = 0; c < 3; ++c)
+      w[k][c] = static_cast<float>(kWheel[k][c]) / 255.f;
+  }
+  return w;
+}();
+
 // Middlebury's computeColor for a flow already divided by the normalising magnitude. Kept in
 // float and truncating like the reference; writes OpenCV's B, G, R order.
 void color_of(float fx, float fy, uchar* bgr) {
@@ -50,38 +63,64 @@ void color_of(float fx, float fy, uchar* bgr) {
   const int k1 = (k0 + 1) % kWheelSize;
   const float f = fk - static_cast<float>(k0);
   for (int c = 0; c < 3; ++c) {
-    const float col0 = static_cast<float>(kWheel[k0][c]) / 255.f;
-    const float col1 = static_cast<float>(kWheel[k1][c]) / 255.f;
+    const float col0 = kWheelF[k0][c];
+    const float col1 = kWheelF[k1][c];
     float col = (1 - f) * col0 + f * col1;
     col = rad <= 1 ? 1 - rad * (1 - col) : col * 0.75f;
     bgr[2 - c] = static_cast<uchar>(255.f * col);
   }
 }
 
+void check_flow(const cv::Mat& flow, const char* what) {
+  if (flow.empty() || flow.type() != CV_32FC2) {
+    throw Error(std::string(what) + ": flow must be non-empty CV_32FC2, got " +
+                std::to_string(flow.cols) + "x" + std::to_string(flow.rows) + " " +
+                cv::typeToString(flow.type()));
+  }
+}
+
 }  // namespace
 
-cv::Mat flow_to_color(const cv::Mat& flow, float max_magnitude) {
-  if (flow.empty() || flow.type() != CV_32FC2) {
-    throw Error("flow_to_color: flow must be non-empty CV_32FC2, got " + std::to_string(flow.cols) +
-                "x" + std::to_string(flow.rows) + " " + cv::typeToString(flow.type()));
+float robust_max_magnitude(const cv::Mat& flow, double percentile) {
+  check_flow(flow, "robust_max_magnitude");
+  if (!(percentile > 0.0 && percentile <= 100.0)) {
+    throw Error("robust_max_magnitude: percentile must be in (0, 100], got " +
+                std::to_string(percentile));
   }
+  // Squared magnitudes: the order is the same, and one square root is taken at the end.
+  std::vector<float> squared;
+  squared.reserve(flow.total());
+  for (int y = 0; y < flow.rows; ++y) {
+    const float* f = flow.ptr<float>(y);
+    for (int x = 0; x < flow.cols; ++x) {
+      if (is_known_flow(f[2 * x], f[2 * x + 1]))
+        squared.push_back(f[2 * x] * f[2 * x] + f[2 * x + 1] * f[2 * x + 1]);
+    }
+  }
+  if (squared.empty()) return 0.f;
+  const auto n = static_cast<double>(squared.size());
+  const std::size_t rank =
+      static_cast<std::size_t>(std::clamp(std::ceil(percentile / 100.0 * n), 1.0, n) - 1.0);
+  std::nth_element(squared.begin(), squared.begin() + static_cast<std::ptrdiff_t>(rank),
+                   squared.end());
+  return std::sqrt(squared[rank]);
+}
+
+float max_magnitude(const cv::Mat& flow) {
+  return robust_max_magnitude(flow, 100.0);
+}
+
+cv::Mat flow_to_color(const cv::Mat& flow, float max_magnitude) {
+  check_flow(flow, "flow_to_color");
   if (std::isinf(max_magnitude)) {
     throw Error("flow_to_color: max_magnitude must be finite, got " +
                 std::to_string(max_magnitude));
   }
   float max_rad = max_magnitude;
   if (!(max_magnitude > 0)) {
-    max_rad = 0;
-    for (int y = 0; y < flow.rows; ++y) {
-      const float* f = flow.ptr<float>(y);
-      for (int x = 0; x < flow.cols; ++x) {
-        if (is_known_flow(f[2 * x], f[2 * x + 1])) {
-          max_rad = std::max(max_rad, std::hypot(f[2 * x], f[2 * x + 1]));
-        }
-      }
-    }
+    max_rad = robust_max_magnitude(flow);
     // An all-zero (or all-unknown) field would divide by zero; any scale gives white.
-    if (max_rad == 0) max_rad = 1;
+    if (!(max_rad > 0)) max_rad = 1;
   }
 
   cv::Mat bgr(flow.size(), CV_8UC3, cv::Scalar::all(0));

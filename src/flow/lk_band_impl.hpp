@@ -315,9 +315,20 @@ void run_band(const BandJob& job) {
   // reach_up + lag + kBatchRows rows).
   const int lag = reach_down(L) + 1;
   const int t_end = last[K - 1] + (K - 1) * lag;
+  // With an on-demand input, the rows made so far end at filled_to.
+  const RowSpan span = input_rows(L, K, job.begin, job.end);
+  int filled_to = span.first;
+  const int input_end = span.first + span.count;
   for (int t = first[0]; t < t_end; t += kBatchRows) {
     for (int k = 0; k < K; ++k) {
       for (int y = t - k * lag; y < t - k * lag + kBatchRows; ++y) {
+        if (k == 0 && job.fill_input && y >= first[0] && y < last[0]) {
+          // Iteration 0's row y reads input rows up to y + reach_down.
+          const int need = imin(input_end, y + reach_down(L) + 1);
+          for (; filled_to < need; ++filled_to)
+            job.fill_input(job.fill_context, filled_to, row_u(job.input, filled_to),
+                           row_v(job.input, filled_to));
+        }
         if (y == first[k]) passes[k].start(y);
         if (y >= first[k] && y < last[k]) passes[k].next_row();
       }

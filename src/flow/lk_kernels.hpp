@@ -60,7 +60,13 @@ struct BandJob {
   const LevelJob* level = nullptr;
   int iterations = 1;
   int begin = 0, end = 0;
-  FlowRows input;                        // what iteration 0 reads
+  FlowRows input;  // what iteration 0 reads
+  // Non-null: `input` is a ring (a FlowRows with a mask) that run_band fills row by row just
+  // before iteration 0 reads it, calling fill_input(fill_context, r, u, v) to write input row r
+  // (w + 1 floats of each component) at u, v. Rows come in increasing order, each once, from the
+  // first row input_rows() names; the ring must hold reach_up + reach_down + 1 + kBatchRows rows.
+  void (*fill_input)(void* context, int row, float* u, float* v) = nullptr;
+  void* fill_context = nullptr;
   FlowRows output;                       // what the last iteration writes
   float* confidence = nullptr;           // last iteration: per row, or null
   std::ptrdiff_t confidence_stride = 0;  // floats, rows indexed from 0 like `output`

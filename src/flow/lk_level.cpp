@@ -129,6 +129,19 @@ void fill_input(const LkKernels& k, const LevelInput& in, const cv::Rect& comp, 
   }
 }
 
+// What BandJob::fill_input needs to make one row of the level's starting flow.
+struct InputSource {
+  const LkKernels* kernels;
+  const LevelInput* input;
+  cv::Rect comp;
+  std::vector<float> temp;
+};
+
+void fill_input_row(void* context, int row, float* u, float* v) {
+  InputSource& s = *static_cast<InputSource*>(context);
+  fill_input(*s.kernels, *s.input, s.comp, row, 1, u, v, 0, s.temp);
+}
+
 // Final rows of each band, each starting on a stripe row. A band below the first recomputes the
 // rows its earlier iterations read above it: two bands are split where their work (rows times
 // iterations) is the most even; more bands about equally.
@@ -223,7 +236,6 @@ void iterate_level(const LevelProblem& p, const LevelInput& input, cv::Mat& u, c
   const std::size_t plane = static_cast<std::size_t>(q) * wp;
   // Each band owns its buffers (sized before the bands start: nothing is allocated in them).
   struct BandPlan {
-    RowSpan span;
     float* input;
     float* rings;
     float* rows;
@@ -232,17 +244,14 @@ void iterate_level(const LevelProblem& p, const LevelInput& input, cv::Mat& u, c
   for (int b = 0; b < bands; ++b) {
     LevelScratch::Band& s = scratch.bands[b];
     BandPlan& bp = plans[b];
-    bp.span = k.input_rows(L, iterations, starts[b], starts[b + 1]);
-    bp.input = s.input.reserve(2 * static_cast<std::size_t>(bp.span.count) * wp);
+    // Iteration 0's input rows are made as it reaches them, into a ring like the iterations'.
+    bp.input = s.input.reserve(2 * plane);
     bp.rings = s.rings.reserve(2 * plane * std::max(0, iterations - 1));
     bp.rows = s.rows.reserve(rows_floats * iterations);
   }
   auto run = [&](int b) {
     const BandPlan& bp = plans[b];
-    std::vector<float> temp;
-    const std::ptrdiff_t count = bp.span.count;
-    fill_input(k, input, c, bp.span.first, bp.span.count, bp.input, bp.input + count * wp, wp,
-               temp);
+    InputSource source{&k, &input, c, {}};
     std::vector<FlowRows> rings(std::max(0, iterations - 1));
     std::vector<float*> rows(iterations);
     for (int i = 0; i + 1 < iterations; ++i) {
@@ -256,7 +265,9 @@ void iterate_level(const LevelProblem& p, const LevelInput& input, cv::Mat& u, c
     job.iterations = iterations;
     job.begin = starts[b];
     job.end = starts[b + 1];
-    job.input = FlowRows{bp.input, bp.input + count * wp, wp, -1, bp.span.first};
+    job.input = FlowRows{bp.input, bp.input + plane, wp, q - 1, 0};
+    job.fill_input = fill_input_row;
+    job.fill_context = &source;
     job.output = flow ? FlowRows{} : FlowRows{u.ptr<float>(), v.ptr<float>(), wp, -1, 0};
     job.confidence = confidence ? confidence->ptr<float>() : nullptr;
     job.confidence_stride =

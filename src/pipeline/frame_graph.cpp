@@ -431,18 +431,57 @@ RunReport run_dense(const FrameSource& source, const flow::LkParams& params,
       run.time("flow", t0);
       return FlowPair{job.seq, job.t.frame, job.t1.frame, std::move(result)};
     });
-    tf::sequencer_node<FlowPair> pair_order(
-        g, [](const FlowPair& p) { return static_cast<std::size_t>(p.seq); });
-    tf::broadcast_node<FlowPair> to_sinks(g);  // a sequencer feeds one successor only
+    // The sinks' parallel parts, one vector entry per sink (empty for a sink without one).
+    struct PreparedPair {
+      FlowPair pair;
+      std::vector<cv::Mat> prepared;
+    };
+    std::vector<std::string> prepare_stage(sinks.size());
+    for (std::size_t i = 0; i < sinks.size(); ++i)
+      prepare_stage[i] = sinks[i].name + ".prepare";
+    tf::function_node<FlowPair, PreparedPair> prepare_node(
+        g, tf::unlimited, [&](const FlowPair& p) {
+          PreparedPair out{p, std::vector<cv::Mat>(sinks.size())};
+          for (std::size_t i = 0; i < sinks.size(); ++i) {
+            if (!sinks[i].prepare) continue;
+            run.enter(Stage::Sink, p.seq);
+            const auto t0 = Clock::now();
+            out.prepared[i] = sinks[i].prepare(p);
+            run.time(prepare_stage[i], t0);
+          }
+          return out;
+        });
+    tf::sequencer_node<PreparedPair> pair_order(
+        g, [](const PreparedPair& p) { return static_cast<std::size_t>(p.pair.seq); });
+    tf::broadcast_node<PreparedPair> to_sinks(g);  // a sequencer feeds one successor only
 
-    // Sinks vote for frame t+1, the newer frame of their pair.
-    auto sink_nodes = make_sink_nodes<FlowPair>(g, run, sinks, 1);
+    // Each sink gets the pair with its own prepared part; sinks vote for frame t+1, the newer
+    // frame of their pair.
+    std::vector<tf::function_node<PreparedPair, RetireMsg>> sink_nodes;
+    sink_nodes.reserve(std::max<std::size_t>(1, sinks.size()));
+    for (std::size_t i = 0; i < sinks.size(); ++i) {
+      sink_nodes.emplace_back(g, tf::serial, [&run, &sinks, i](const PreparedPair& m) {
+        run.enter(Stage::Sink, m.pair.seq);
+        const auto t0 = Clock::now();
+        FlowPair p = m.pair;
+        p.prepared = m.prepared[i];
+        sinks[i].consume(p);
+        run.time(sinks[i].name, t0);
+        return RetireMsg{m.pair.seq + 1, 1};
+      });
+    }
+    if (sinks.empty()) {
+      sink_nodes.emplace_back(g, tf::serial, [](const PreparedPair& m) {
+        return RetireMsg{m.pair.seq + 1, 1};
+      });
+    }
     RetireNode retire = make_retire_node(g, run, static_cast<int>(sink_nodes.size()));
 
     tf::make_edge(front.output(), pair);
     tf::make_edge(tf::output_port<0>(pair), flow_node);
     tf::make_edge(tf::output_port<1>(pair), retire);
-    tf::make_edge(flow_node, pair_order);
+    tf::make_edge(flow_node, prepare_node);
+    tf::make_edge(prepare_node, pair_order);
     tf::make_edge(pair_order, to_sinks);
     for (auto& node : sink_nodes) {
       tf::make_edge(to_sinks, node);

@@ -31,7 +31,8 @@
 // Dense mode: the same front end, then a serial node that pairs each frame with the previous
 // one (each pyramid serves two pairs, built once), a flow node that runs several pairs at once
 // (one thread each: more pairs are in flight than threads, and row tiles on top cost
-// throughput), a sequencer that restores pair order, and the sinks.
+// throughput), a prepare node that runs the sinks' parallel parts (FlowSink::prepare, several
+// pairs at once), a sequencer that restores pair order, and the sinks' ordered parts.
 //
 // Errors: an exception in the source, a stage or a sink cancels the graph; the run function
 // waits for the nodes already running, then rethrows it (so the caller reports it; sinks keep
@@ -118,11 +119,19 @@ struct FlowPair {
   std::shared_ptr<const stages::Frame> frame_t;
   std::shared_ptr<const stages::Frame> frame_t1;
   std::shared_ptr<const flow::FlowResult> flow;  // whole-frame flow t -> t+1
+  // In FlowSink::consume: what that sink's `prepare` made of this pair (empty without one).
+  cv::Mat prepared = {};
 };
 
+// A sink of dense mode in two parts. `prepare` (optional, thread-safe) is the costly, parallel
+// part, e.g. colour coding and PNG encoding: it runs on several pairs at once, in any order, as
+// soon as a pair's flow exists (its time is the "<name>.prepare" stage). `consume` is the
+// ordered part, e.g. the write: one pair at a time, in pair order, with FlowPair::prepared set
+// to what `prepare` returned for that pair.
 struct FlowSink {
   std::string name;
   std::function<void(const FlowPair&)> consume;
+  std::function<cv::Mat(const FlowPair&)> prepare = {};
 };
 
 RunReport run_dense(const FrameSource& source, const flow::LkParams& params,

@@ -6,14 +6,16 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 #include <string_view>
 #include <system_error>
 #include <utility>
+#include <vector>
 
+#include "core/atomic_write.hpp"
 #include "core/error.hpp"
-#include "eval/image_io.hpp"
 
 namespace roiflow::stages {
 namespace {
@@ -126,12 +128,11 @@ VideoSink& VideoSink::operator=(VideoSink&& other) noexcept {
   return *this;
 }
 
-void VideoSink::write(const cv::Mat& frame) {
-  const std::string where = "video sink '" + path_ + "', frame " + std::to_string(frames_ + 1);
-  if (closed_) throw Error(where + ": written after close()");
+cv::Mat VideoSink::encode(const cv::Mat& frame) const {
+  const std::string where = "video sink '" + path_ + "'";
   if (frame.empty()) throw Error(where + ": empty frame");
   if (frame.size() != size_) {
-    throw Error(where + ": size " + size_text(frame.size()) + ", the sink was opened for " +
+    throw Error(where + ": frame size " + size_text(frame.size()) + ", the sink was opened for " +
                 size_text(size_));
   }
   cv::Mat bgr;
@@ -140,13 +141,39 @@ void VideoSink::write(const cv::Mat& frame) {
   } else if (frame.type() == CV_8UC1) {
     cv::cvtColor(frame, bgr, cv::COLOR_GRAY2BGR);
   } else {
-    throw Error(where + ": type " + cv::typeToString(frame.type()) +
+    throw Error(where + ": frame type " + cv::typeToString(frame.type()) +
                 ", expected 8-bit BGR or gray");
   }
+  if (!codec_.empty()) return bgr;
+  std::vector<uchar> png;
+  // Fastest zlib level with run-length matches: lossless, and for pictures with flat areas (colour-
+  // coded flow) about 10 % faster and 30 % smaller than the default strategy.
+  if (!cv::imencode(".png", bgr, png,
+                    {cv::IMWRITE_PNG_COMPRESSION, 1, cv::IMWRITE_PNG_STRATEGY,
+                     cv::IMWRITE_PNG_STRATEGY_RLE})) {
+    throw Error(where + ": cannot encode a PNG frame");
+  }
+  return cv::Mat(png, true).reshape(1, 1);
+}
+
+void VideoSink::write(const cv::Mat& frame) {
+  write_encoded(encode(frame));
+}
+
+void VideoSink::write_encoded(const cv::Mat& encoded) {
+  const std::string where = "video sink '" + path_ + "', frame " + std::to_string(frames_ + 1);
+  if (closed_) throw Error(where + ": written after close()");
   if (writer_) {
-    writer_->write(bgr);
+    if (encoded.type() != CV_8UC3 || encoded.size() != size_) {
+      throw Error(where + ": not a frame encode() made for this sink");
+    }
+    writer_->write(encoded);
   } else {
-    eval::write_image_atomically((fs::path(path_) / frame_name(frames_ + 1)).string(), bgr);
+    if (encoded.type() != CV_8UC1 || encoded.rows != 1 || !encoded.isContinuous()) {
+      throw Error(where + ": not a frame encode() made for this sink");
+    }
+    const std::string path = (fs::path(path_) / frame_name(frames_ + 1)).string();
+    write_bytes_atomically(path, "image ", encoded.data, encoded.total());
   }
   ++frames_;
 }

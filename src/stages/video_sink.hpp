@@ -2,6 +2,8 @@
 //
 //   roiflow::stages::VideoSink sink("run/annotated.mp4", source.fps(), source.size());
 //   while (...) sink.write(annotate_frame(frame.image, out));   // 8-bit BGR or gray
+//   cv::Mat png = sink.encode(picture);      // on any thread (e.g. a parallel graph node) ...
+//   sink.write_encoded(png);                 // ... then written in order
 //   std::cerr << sink.description() << ": " << sink.frames() << " frames\n";
 //   sink.close();                                                // or let the destructor do it
 //
@@ -22,7 +24,7 @@
 // close() is idempotent and the destructor calls it (never throwing), so a run interrupted by
 // an exception still leaves a playable video holding every frame written so far. (A process
 // killed outright cannot finalise an .mp4's index; .avi and PNG folders survive that better.)
-// Not thread-safe: one writer at a time.
+// Not thread-safe, but for encode(): one writer at a time.
 #pragma once
 
 #include <memory>
@@ -43,6 +45,12 @@ class VideoSink {
   VideoSink& operator=(VideoSink&&) noexcept;
 
   void write(const cv::Mat& frame);
+  // write() in two parts, so that the costly one runs on several frames at once: encode() is
+  // const and thread-safe (it checks the frame, converts gray to BGR and, for a PNG folder,
+  // encodes the PNG: a 1xN CV_8U row of its bytes); write_encoded() writes what encode()
+  // returned, in order, one at a time. write(f) is write_encoded(encode(f)).
+  cv::Mat encode(const cv::Mat& frame) const;
+  void write_encoded(const cv::Mat& encoded);
   void close();
 
   long long frames() const;  // written so far

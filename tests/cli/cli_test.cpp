@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "eval/flo_io.hpp"
+#include "eval/kitti_flow.hpp"
 #include "eval/synthetic.hpp"
 #include "eval/track_log.hpp"
 #include "eval/tracking_scene.hpp"
@@ -391,6 +392,36 @@ TEST_F(CliVideoTest, DenseWritesOneColourFramePerPair) {
   const auto summary = nlohmann::json::parse(read_text(path("dense.json")));
   EXPECT_EQ(summary.at("pairs").get<long long>(), 5);
   EXPECT_EQ(summary.at("mode").get<std::string>(), "dense");
+}
+
+// The raw flow of every pair as KITTI PNGs (and as .flo), equal to `roiflow flow` on the same
+// frames to the format's 1/64 px; the run at 2 threads writes the same files as at 1.
+TEST_F(CliVideoTest, DenseWritesTheRawFlowOfEveryPair) {
+  for (const char* threads : {"1", "2"}) {
+    const std::string dir = path(std::string("kitti") + threads);
+    const CliResult r = run({"dense", path("scene.avi"), "--flow-out", dir, "--flow-format",
+                             "kitti", "--max-frames", "5", "--threads", threads, "--no-progress"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  const CliResult flo = run({"dense", path("scene.avi"), "--flow-out", path("flo"), "--out",
+                             path("colour"), "--max-frames", "5", "--no-progress"});
+  ASSERT_EQ(flo.exit_code, 0) << flo.err;
+  for (int i = 1; i <= 4; ++i) {
+    const std::string name = "00000" + std::to_string(i);
+    EXPECT_EQ(read_text(path("kitti1/" + name + ".png")),
+              read_text(path("kitti2/" + name + ".png")));
+    const cv::Mat exact = eval::read_flo(path("flo/" + name + ".flo"));
+    const cv::Mat kitti = eval::read_kitti_flow(path("kitti1/" + name + ".png"));
+    ASSERT_EQ(exact.size(), cv::Size(160, 120));
+    EXPECT_LE(cv::norm(exact, kitti, cv::NORM_INF), 1.0 / 128 + 1e-4) << name;
+    EXPECT_FALSE(cv::imread(path("colour/" + name + ".png")).empty());
+  }
+  EXPECT_FALSE(fs::exists(path("flo/000005.flo")));
+  EXPECT_FALSE(fs::exists(path("kitti1/000005.png")));
+  const CliResult bad = run({"dense", path("scene.avi"), "--flow-out", path("x"), "--flow-format",
+                             "png", "--no-progress"});
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_EQ(lines_of(bad.err).size(), 1u) << bad.err;
 }
 
 TEST_F(CliVideoTest, DemoTracksTheSceneAndPrintsItsError) {

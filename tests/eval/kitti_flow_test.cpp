@@ -82,6 +82,17 @@ TEST(KittiFlow, OutOfRangeFlowThrowsInsteadOfClamping) {
       std::string::npos);
 }
 
+TEST(KittiFlow, OutOfRangeFlowCanBeWrittenInvalidInstead) {
+  cv::Mat flow(1, 3, CV_32FC2, cv::Scalar(1.5, -2.25));
+  flow.at<cv::Vec2f>(0, 1) = {600.f, 0.f};
+  const cv::Mat png = encode_kitti_flow(flow, /*out_of_range_invalid=*/true);
+  EXPECT_EQ(png.at<cv::Vec3w>(0, 1), cv::Vec3w(0, 0, 0));
+  const cv::Mat back = decode_kitti_flow(png);
+  EXPECT_FALSE(flow::is_known_flow(back.at<cv::Vec2f>(0, 1)[0], back.at<cv::Vec2f>(0, 1)[1]));
+  EXPECT_EQ(back.at<cv::Vec2f>(0, 0), cv::Vec2f(1.5f, -2.25f));
+  EXPECT_EQ(back.at<cv::Vec2f>(0, 2), cv::Vec2f(1.5f, -2.25f));
+}
+
 TEST(KittiFlow, DecodeRejectsWhatIsNotSixteenBitThreeChannel) {
   for (const cv::Mat& bad :
        {cv::Mat(), cv::Mat(2, 2, CV_8UC3, cv::Scalar::all(1)),

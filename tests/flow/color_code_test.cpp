@@ -120,6 +120,45 @@ TEST(ColorCode, RejectsBadInput) {
                Error);
 }
 
+TEST(ColorCode, RobustMaximumIsANearestRankPercentile) {
+  // Magnitudes 1..100 (3-4-5 triangles), one unknown pixel that must not count.
+  cv::Mat flow(1, 101, CV_32FC2);
+  for (int i = 0; i < 100; ++i)
+    flow.at<cv::Vec2f>(0, i) = {0.6f * static_cast<float>(i + 1),
+                                -0.8f * static_cast<float>(i + 1)};
+  flow.at<cv::Vec2f>(0, 100) = {kUnknown, 0};
+  EXPECT_NEAR(robust_max_magnitude(flow, 99.0), 99.f, 1e-4f);
+  EXPECT_NEAR(robust_max_magnitude(flow, 50.0), 50.f, 1e-4f);
+  EXPECT_NEAR(robust_max_magnitude(flow, 0.5), 1.f, 1e-4f);
+  EXPECT_NEAR(max_magnitude(flow), 100.f, 1e-4f);
+  EXPECT_EQ(robust_max_magnitude(cv::Mat(2, 2, CV_32FC2, cv::Scalar(kNaN, 0))), 0.f);
+  EXPECT_THROW(robust_max_magnitude(flow, 0.0), Error);
+  EXPECT_THROW(robust_max_magnitude(flow, 100.5), Error);
+  EXPECT_THROW(robust_max_magnitude(cv::Mat(2, 2, CV_32FC1, cv::Scalar(0))), Error);
+}
+
+TEST(ColorCode, AFewOutliersDoNotWashThePictureOut) {
+  // A smooth field up to 2 px and 0.2 % of its pixels at 50 px (border outliers of an
+  // estimate): the automatic scale stays near 2, so a 1 px vector is still half saturated.
+  cv::Mat flow(64, 64, CV_32FC2);
+  cv::RNG rng(5);
+  rng.fill(flow, cv::RNG::UNIFORM, cv::Scalar::all(-1.41), cv::Scalar::all(1.41));
+  flow.at<cv::Vec2f>(10, 10) = {1, 0};
+  for (int i = 0; i < 8; ++i)
+    flow.at<cv::Vec2f>(0, 3 * i) = {50, 0};
+  const float scale = robust_max_magnitude(flow);
+  EXPECT_LT(scale, 2.f);
+  EXPECT_GT(scale, 1.7f);
+  const cv::Mat bgr = flow_to_color(flow);
+  expect_near(bgr.at<cv::Vec3b>(10, 10), color(1, 0, scale), 0);
+  // With the plain maximum the same vector would be nearly white: that is what must not happen.
+  const cv::Vec3b washed = color(1, 0, max_magnitude(flow));
+  EXPECT_GT(washed[0], 240);
+  EXPECT_LT(bgr.at<cv::Vec3b>(10, 10)[0], 160);
+  // The outliers themselves keep their hue (darkened red, not black).
+  expect_near(bgr.at<cv::Vec3b>(0, 0), {0, 0, 191});
+}
+
 TEST(ColorCode, LegendAnchorsAndBackground) {
   const int size = 151;
   const int c = size / 2;

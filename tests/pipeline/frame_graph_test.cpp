@@ -188,6 +188,81 @@ TEST_P(FrameGraphThreads, DenseDeliversEveryPairInOrderAndEqualsTheSerialFlow) {
   EXPECT_EQ(report.frames, kFrames);
 }
 
+// A sink's prepare runs on several pairs at once and in any order; what it made reaches that
+// sink's consume with the right pair, in pair order, and another sink sees nothing of it.
+TEST_P(FrameGraphThreads, DensePreparedPartsReachTheirSinkInOrder) {
+  constexpr long long kFrames = 24;
+  ShiftingSource source({96, 72}, kFrames);
+  std::atomic<int> running{0}, most{0};
+  std::atomic<bool> waited{false};
+  std::vector<long long> order, plain;
+  GraphOptions options;
+  options.threads = GetParam();
+  options.on_stage = random_delay;
+  FlowSink encoded{"encoded",
+                   [&](const FlowPair& p) {
+                     order.push_back(p.seq);
+                     ASSERT_EQ(p.prepared.type(), CV_64FC1);
+                     EXPECT_EQ(p.prepared.at<double>(0), static_cast<double>(p.seq));
+                     EXPECT_EQ(p.prepared.at<double>(1), p.flow->flow.at<cv::Vec2f>(10, 10)[0]);
+                   },
+                   [&](const FlowPair& p) {
+                     const int now = ++running;
+                     int seen = most.load();
+                     while (now > seen && !most.compare_exchange_weak(seen, now)) {
+                     }
+                     // The first prepare waits (up to 5 s, on a loaded machine too) for another
+                     // one to start beside it: only a node that runs them one at a time fails.
+                     bool expected = false;
+                     if (GetParam() > 1 && waited.compare_exchange_strong(expected, true)) {
+                       const auto until =
+                           std::chrono::steady_clock::now() + std::chrono::seconds(5);
+                       while (most.load() < 2 && std::chrono::steady_clock::now() < until)
+                         std::this_thread::sleep_for(std::chrono::microseconds(200));
+                     }
+                     --running;
+                     return cv::Mat(cv::Matx21d(static_cast<double>(p.seq),
+                                                p.flow->flow.at<cv::Vec2f>(10, 10)[0]));
+                   }};
+  FlowSink other{"other", [&](const FlowPair& p) {
+                   plain.push_back(p.seq);
+                   EXPECT_TRUE(p.prepared.empty());
+                 }};
+  finishes([&] {
+    run_dense(std::ref(source), flow::LkParams::paper(), {encoded, other}, options);
+  });
+  ASSERT_EQ(order.size(), static_cast<std::size_t>(kFrames - 1));
+  for (std::size_t i = 0; i < order.size(); ++i)
+    EXPECT_EQ(order[i], static_cast<long long>(i));
+  EXPECT_EQ(plain, order);
+  if (GetParam() > 1) {
+    EXPECT_GT(most.load(), 1) << "prepare never ran on two pairs at once";
+  } else {
+    EXPECT_EQ(most.load(), 1);
+  }
+}
+
+TEST(FrameGraph, AnExceptionInAPrepareEndsADenseRunWithItsMessage) {
+  ShiftingSource source({64, 48}, 200);
+  GraphOptions options;
+  options.threads = 2;
+  std::string message;
+  std::atomic<long long> written{0};
+  finishes([&] {
+    message = error_message([&] {
+      run_dense(std::ref(source), flow::LkParams::paper(),
+                {{"sink", [&](const FlowPair&) { ++written; },
+                  [](const FlowPair& p) {
+                    if (p.seq == 12) throw Error("cannot encode pair 12");
+                    return cv::Mat();
+                  }}},
+                options);
+    });
+  });
+  EXPECT_EQ(message, "cannot encode pair 12");
+  EXPECT_LE(written.load(), 12);  // nothing after the failed pair reaches the ordered writer
+}
+
 // The real tracker without a given target (so the background model is refreshed beside the
 // frames while the target is held, through the executor's start) and with a jump it must find
 // again: every box, lost flag, mode and activation count equals those of the serial tracker.

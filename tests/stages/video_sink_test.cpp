@@ -9,6 +9,7 @@
 #include <opencv2/videoio.hpp>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -123,6 +124,42 @@ TEST_F(VideoSinkTest, PngFolderHoldsNumberedWholeFrames) {
   const cv::Mat third = cv::imread(folder + "/000003.png", cv::IMREAD_UNCHANGED);
   ASSERT_EQ(third.type(), CV_8UC3);
   EXPECT_EQ(third.at<cv::Vec3b>(5, 5), cv::Vec3b(77, 77, 77));
+}
+
+TEST_F(VideoSinkTest, EncodedOnOtherThreadsThenWrittenInOrder) {
+  // Folder: encode() makes the PNG bytes; video: the BGR frame. Either way write_encoded()
+  // writes them in its own order, whatever order the encodings finished in.
+  for (const std::string name : {"frames", "out.avi"}) {
+    SCOPED_TRACE(name);
+    VideoSink sink(path(name), 25, kSize);
+    std::vector<cv::Mat> encoded(4);
+    std::vector<std::thread> threads;
+    for (int i = 3; i >= 0; --i)
+      threads.emplace_back([&, i] { encoded[i] = sink.encode(make_frame(i)); });
+    for (std::thread& t : threads)
+      t.join();
+    for (const cv::Mat& e : encoded)
+      sink.write_encoded(e);
+    sink.close();
+    EXPECT_EQ(sink.frames(), 4);
+    if (name == "frames") {
+      EXPECT_EQ(encoded[0].type(), CV_8UC1);
+      for (int i = 0; i < 4; ++i) {
+        const cv::Mat back = cv::imread(path(name) + "/00000" + std::to_string(i + 1) + ".png",
+                                        cv::IMREAD_UNCHANGED);
+        ASSERT_FALSE(back.empty());
+        EXPECT_EQ(cv::norm(back, make_frame(i), cv::NORM_INF), 0.0) << i;
+      }
+    } else {
+      EXPECT_EQ(decode(path(name)).frames, 4);
+    }
+  }
+  // What encode() made for a folder is not a video frame, and the reverse.
+  VideoSink folder(path("f2"), 25, kSize), video(path("v2.avi"), 25, kSize);
+  EXPECT_THROW(video.write_encoded(folder.encode(make_frame(0))), Error);
+  EXPECT_THROW(folder.write_encoded(video.encode(make_frame(0))), Error);
+  EXPECT_THROW(folder.encode(cv::Mat(32, 32, CV_8UC3, cv::Scalar::all(0))), Error);
+  EXPECT_EQ(folder.frames(), 0);
 }
 
 TEST_F(VideoSinkTest, TrailingSlashOrExistingDirectoryMeansAFolder) {
