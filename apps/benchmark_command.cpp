@@ -3,6 +3,7 @@
 //
 //   roiflow benchmark data/tracking --out out/bench --trackers roiflow,csrt,kcf,mosse,medianflow
 //   -> out/bench/benchmark.md, benchmark.csv, success.svg, precision.svg; the table on stdout
+//   roiflow benchmark data/tracking --out out/bench --trackers roiflow --tracks   # + track logs
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <iostream>
@@ -28,6 +29,7 @@ struct BenchmarkCommand {
   int roi = stages::TrackerParams{}.roi;
   double lk_patches = stages::LocalTrackerParams{}.lk_patches;
   bool progress = true;
+  bool tracks = false;
 };
 
 void run_benchmark_command(const BenchmarkCommand& cmd) {
@@ -61,7 +63,7 @@ void run_benchmark_command(const BenchmarkCommand& cmd) {
     };
   }
   const pipeline::BenchmarkResult result = pipeline::run_benchmark(options);
-  const std::vector<std::string> written = pipeline::write_benchmark(result, cmd.out);
+  const std::vector<std::string> written = pipeline::write_benchmark(result, cmd.out, cmd.tracks);
   std::cout << eval::format_benchmark_markdown(result.rows, result.means) << "\n";
   std::string list;
   for (const std::string& w : written)
@@ -114,6 +116,10 @@ void add_benchmark_command(CLI::App& app) {
                   "(0 = always full resolution)")
       ->check(CLI::Range(0.0, 100.0))
       ->capture_default_str();
+  sub->add_flag(
+      "--tracks", cmd.tracks,
+      "also write every run's track log, OUT/tracks/<sequence>/<tracker>.csv (the format of "
+      "roiflow track --log; roiflow score reads it)");
   sub->add_flag("!--no-progress", cmd.progress, "no line per finished sequence on stderr");
   cmd.lk.threads = hardware_threads();
   add_lk_options(*sub, cmd.lk);

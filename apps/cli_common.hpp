@@ -50,6 +50,7 @@ void add_video_commands(CLI::App& app, int& exit_code);
 void add_sweep_command(CLI::App& app);      // roiflow sweep (sweep_command.cpp)
 void add_benchmark_command(CLI::App& app);  // roiflow benchmark (benchmark_command.cpp)
 void add_scaling_command(CLI::App& app);    // roiflow scaling (scaling_command.cpp)
+void add_batch_command(CLI::App& app, int& exit_code);  // roiflow batch (batch_command.cpp)
 void add_motion_check_command(CLI::App& app, int& exit_code);  // roiflow motion-check
 // roiflow score --mot PRED GT (mot_score_command.cpp)
 void print_mot_score(const std::string& pred, const std::string& gt, const std::string& format);

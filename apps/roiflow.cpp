@@ -432,6 +432,7 @@ int main(int argc, char** argv) {
   add_sweep_command(app);
   add_scaling_command(app);
   add_benchmark_command(app);
+  add_batch_command(app, exit_code);
   add_motion_check_command(app, exit_code);
 
   try {

@@ -10,6 +10,10 @@ packages=(
   libopencv-dev libopencv-contrib-dev libavformat-dev libavcodec-dev libavutil-dev libswscale-dev libtbb-dev libcli11-dev nlohmann-json3-dev libeigen3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   clang libclang-rt-14-dev dpkg-dev
+  # the drop-in bindings (docs/DROPIN.md): Python module, GStreamer plugin, Dask batches
+  python3-dev pybind11-dev python3-numpy python3-pytest python3-distributed
+  libgstreamer1.0-dev libgstreamer-plugins-base1.0-dev gstreamer1.0-tools
+  gstreamer1.0-plugins-base gstreamer1.0-plugins-good gstreamer1.0-libav
 )
 
 missing=()

@@ -4,9 +4,11 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <initializer_list>
 #include <limits>
 #include <map>
 #include <set>
+#include <string_view>
 #include <system_error>
 
 #include "core/error.hpp"
@@ -41,6 +43,37 @@ OtbSequence read_sequence(const fs::path& dir) {
                 ": the target is absent in the first frame (a tracker starts from that box)");
   }
   return s;
+}
+
+// Appends the parts in order (GCC 12 misreads `"literal" + std::string&&` chains as overlapping
+// copies, -Wrestrict).
+void append(std::string& out, std::initializer_list<std::string_view> parts) {
+  for (std::string_view p : parts)
+    out += p;
+}
+
+// A CSV field: quoted (quotes doubled) when it holds a comma, a quote or a line break.
+std::string csv_field(const std::string& text) {
+  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (char c : text) {
+    if (c == '"') quoted += '"';
+    quoted += c;
+  }
+  return quoted + "\"";
+}
+
+// A Markdown table cell: '|' escaped, line breaks as spaces.
+std::string md_cell(const std::string& text) {
+  std::string cell;
+  for (char c : text) {
+    if (c == '|') {
+      cell += "\\|";
+    } else {
+      cell += (c == '\n' || c == '\r') ? ' ' : c;
+    }
+  }
+  return cell;
 }
 
 std::string share_text(const BenchmarkRow& r) {
@@ -83,6 +116,19 @@ std::vector<OtbSequence> find_otb_sequences(const std::string& dir,
                 "' holds no sequence (a folder with groundtruth_rect.txt and img/)");
   }
   return sequences;
+}
+
+std::string track_log_csv(const TrackerRun& run) {
+  std::string csv = std::string(kTrackCsvHeader) + "\n";
+  for (std::size_t i = 0; i < run.boxes.size(); ++i) {
+    TrackRecord r;
+    r.frame = static_cast<long long>(i) + 1;
+    r.box = run.boxes[i];
+    r.lost = i < run.lost.size() && run.lost[i];
+    r.ms = i < run.ms.size() ? run.ms[i] : 0.0;
+    csv += track_csv_row(r);
+  }
+  return csv;
 }
 
 double BenchmarkRow::lost_share() const {
@@ -181,7 +227,7 @@ std::string format_benchmark_markdown(const std::vector<BenchmarkRow>& rows,
   std::string md = "Success AUC (OTB one-pass evaluation)\n\n| sequence |";
   std::string rule = "|---|";
   for (const BenchmarkRow& m : means) {
-    md += " " + m.tracker + " |";
+    append(md, {" ", md_cell(m.tracker), " |"});
     rule += "---:|";
   }
   md += "\n" + rule + "\n";
@@ -193,7 +239,7 @@ std::string format_benchmark_markdown(const std::vector<BenchmarkRow>& rows,
     by[{r.sequence, r.tracker}] = &r;
   }
   for (const std::string& s : sequences) {
-    md += "| " + s + " |";
+    append(md, {"| ", md_cell(s), " |"});
     for (const BenchmarkRow& m : means) {
       const auto it = by.find({s, m.tracker});
       md += ' ';
@@ -216,9 +262,29 @@ std::string format_benchmark_markdown(const std::vector<BenchmarkRow>& rows,
       "lost at IoU 0 |\n|---|---|---:|---:|---:|---:|---:|---:|---:|\n";
   const auto line = [&](const BenchmarkRow& r, bool bold) {
     const std::string b = bold ? "**" : "";
-    md += "| " + b + r.sequence + b + " | " + r.tracker + " | " + std::to_string(r.frames) + " | " +
-          b + fixed(r.auc, 3) + b + " | " + fixed(r.precision20, 3) + " | " + fixed(r.mean_iou, 3) +
-          " | " + fixed(r.fps, 1) + " | " + std::to_string(r.lost) + " | " + share_text(r) + " |\n";
+    append(md, {"| ",
+                b,
+                md_cell(r.sequence),
+                b,
+                " | ",
+                md_cell(r.tracker),
+                " | ",
+                std::to_string(r.frames),
+                " | ",
+                b,
+                fixed(r.auc, 3),
+                b,
+                " | ",
+                fixed(r.precision20, 3),
+                " | ",
+                fixed(r.mean_iou, 3),
+                " | ",
+                fixed(r.fps, 1),
+                " | ",
+                std::to_string(r.lost),
+                " | ",
+                share_text(r),
+                " |\n"});
   };
   for (const BenchmarkRow& r : rows)
     line(r, false);
@@ -234,9 +300,9 @@ std::string format_benchmark_csv(const std::vector<BenchmarkRow>& rows,
       "zero_iou_lost,lost_share\n";
   const auto line = [&](const BenchmarkRow& r) {
     const double share = r.lost_share();
-    csv += r.sequence + "," + r.tracker + "," + std::to_string(r.frames) + "," +
-           std::to_string(r.scored) + "," + fixed(r.auc, 4) + "," + fixed(r.precision20, 4) + "," +
-           fixed(r.mean_iou, 4) + "," + fixed(r.fps, 2) + "," + fixed(r.cpu_s, 4) + "," +
+    csv += csv_field(r.sequence) + "," + csv_field(r.tracker) + "," + std::to_string(r.frames) +
+           "," + std::to_string(r.scored) + "," + fixed(r.auc, 4) + "," + fixed(r.precision20, 4) +
+           "," + fixed(r.mean_iou, 4) + "," + fixed(r.fps, 2) + "," + fixed(r.cpu_s, 4) + "," +
            std::to_string(r.lost) + "," + std::to_string(r.zero_iou) + "," +
            std::to_string(r.zero_iou_lost) + "," +
            (std::isfinite(share) ? fixed(share, 4) : std::string()) + "\n";

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "eval/otb_score.hpp"
+#include "eval/track_log.hpp"
 
 namespace roiflow::eval {
 
@@ -47,8 +48,14 @@ std::vector<OtbSequence> find_otb_sequences(const std::string& dir,
 struct TrackerRun {
   std::vector<cv::Rect2f> boxes;
   std::vector<bool> lost;
-  double cpu_s = 0;  // CPU time of the tracker's calls over these frames
+  double cpu_s = 0;        // CPU time of the tracker's calls over these frames
+  std::vector<double> ms;  // optional: the CPU time of each frame's call, milliseconds
 };
+
+// The run as a track log (track_log.hpp's CSV, header included): frame i + 1, box i, lost i,
+// ms i (0 without ms), no velocity, mode local. `roiflow score` reads it back (its boxes rounded to
+// 2 decimals, so its scores can differ from score_run's in the fourth decimal).
+std::string track_log_csv(const TrackerRun& run);
 
 struct BenchmarkRow {
   std::string sequence;  // "mean" for a tracker's mean row

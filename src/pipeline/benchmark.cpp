@@ -103,7 +103,9 @@ void run_job(Job& job, const BenchmarkOptions& options) {
       const stages::BoxUpdate u = frames == 0
                                       ? trackers[t]->start(*frame, bgr, job.sequence.truth.front())
                                       : trackers[t]->next(*frame, bgr);
-      job.runs[t].cpu_s += thread_cpu_s() - start;
+      const double spent = thread_cpu_s() - start;
+      job.runs[t].cpu_s += spent;
+      job.runs[t].ms.push_back(1000.0 * spent);
       job.runs[t].boxes.push_back(u.box);
       job.runs[t].lost.push_back(u.lost);
     }
@@ -173,6 +175,7 @@ BenchmarkResult run_benchmark(const BenchmarkOptions& options) {
     for (std::size_t t = 0; t < options.trackers.size(); ++t) {
       result.rows.push_back(
           eval::score_run(job.sequence.name, options.trackers[t], job.sequence.truth, job.runs[t]));
+      result.runs.push_back(job.runs[t]);
     }
   }
   result.means = eval::tracker_means(result.rows, options.trackers);
@@ -198,8 +201,8 @@ void check_benchmark_out(const std::string& out_dir) {
   }
 }
 
-std::vector<std::string> write_benchmark(const BenchmarkResult& result,
-                                         const std::string& out_dir) {
+std::vector<std::string> write_benchmark(const BenchmarkResult& result, const std::string& out_dir,
+                                         bool tracks) {
   check_benchmark_out(out_dir);
   // Everything is rendered before the first file is written.
   const std::string md = eval::format_benchmark_markdown(result.rows, result.means);
@@ -218,6 +221,20 @@ std::vector<std::string> write_benchmark(const BenchmarkResult& result,
     const std::string path = (dir / name).string();
     write_text_atomically(path, text);
     written.push_back(path);
+  }
+  if (tracks) {
+    if (result.runs.size() != result.rows.size()) {
+      throw Error("benchmark: " + std::to_string(result.runs.size()) + " runs for " +
+                  std::to_string(result.rows.size()) + " rows");
+    }
+    for (std::size_t i = 0; i < result.rows.size(); ++i) {
+      const fs::path folder = dir / "tracks" / result.rows[i].sequence;
+      fs::create_directories(folder, ec);
+      if (ec) throw Error("--out: cannot make folder '" + folder.string() + "': " + ec.message());
+      write_text_atomically((folder / (result.rows[i].tracker + ".csv")).string(),
+                            eval::track_log_csv(result.runs[i]));
+    }
+    written.push_back((dir / "tracks").string());
   }
   return written;
 }

@@ -52,6 +52,7 @@ struct BenchmarkResult {
   std::vector<eval::BenchmarkRow> rows;   // sequence by sequence (sorted), trackers in order
   std::vector<eval::BenchmarkRow> means;  // one per tracker, in order
   std::vector<std::string> skipped;       // sub-folders that are not sequences
+  std::vector<eval::TrackerRun> runs;     // what each row's tracker reported, row by row
 };
 
 // Throws roiflow::Error before any work on bad options or input (see above).
@@ -63,7 +64,10 @@ BenchmarkResult run_benchmark(const BenchmarkOptions& options);
 void check_benchmark_out(const std::string& out_dir);
 
 // Writes out_dir/benchmark.md, benchmark.csv, success.svg and precision.svg (made if missing),
-// each atomically; returns their paths.
-std::vector<std::string> write_benchmark(const BenchmarkResult& result, const std::string& out_dir);
+// each atomically; with `tracks`, also every run's track log as
+// out_dir/tracks/<sequence>/<tracker>.csv (eval::track_log_csv). Returns the paths of the four
+// files, then the tracks folder when written.
+std::vector<std::string> write_benchmark(const BenchmarkResult& result, const std::string& out_dir,
+                                         bool tracks = false);
 
 }  // namespace roiflow::pipeline

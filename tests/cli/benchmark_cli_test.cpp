@@ -55,6 +55,26 @@ TEST_F(BenchmarkCliTest, PrintsTheTableAndWritesTablesAndPlots) {
   EXPECT_NE(read_text(path("out/success.svg")).find("Success plots of OPE (2 sequences)"),
             std::string::npos);
   EXPECT_NE(read_text(path("out/precision.svg")).find("Precision plots of OPE"), std::string::npos);
+  EXPECT_FALSE(fs::exists(path("out/tracks")));
+}
+
+TEST_F(BenchmarkCliTest, TracksWritesALogPerRunThatScoreReads) {
+  const CliResult r = run({"benchmark", path("set"), "--out", path("out"), "--trackers",
+                           "roiflow,kcf", "--sequences", "beta", "--tracks", "--no-progress"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  for (const char* tracker : {"roiflow", "kcf"}) {
+    SCOPED_TRACE(tracker);
+    const std::string log = path(std::string("out/tracks/beta/") + tracker + ".csv");
+    const std::vector<std::string> lines = lines_of(read_text(log));
+    ASSERT_EQ(lines.size(), 11u);
+    EXPECT_EQ(lines[0], "frame,x,y,w,h,vx,vy,mode,lost,ms");
+    const CliResult s =
+        run({"score", log, path("set/beta/groundtruth_rect.txt"), "--format", "json"});
+    EXPECT_EQ(s.exit_code, 0) << s.err;
+    EXPECT_NE(s.out.find("\"frames\": 10"), std::string::npos) << s.out;
+  }
+  EXPECT_FALSE(fs::exists(path("out/tracks/alpha")));
 }
 
 TEST_F(BenchmarkCliTest, BadInputFailsWithOneLineAndNoOutput) {

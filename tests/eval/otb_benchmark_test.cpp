@@ -182,6 +182,20 @@ TEST(OtbBenchmarkTest, TablesHoldEveryRowAndTheMeans) {
       << md;
 }
 
+TEST(OtbBenchmarkTest, TablesEscapeNamesThatWouldBreakThem) {
+  TrackerRun a;
+  a.boxes = {{0, 0, 10, 10}};
+  a.lost = {false};
+  a.cpu_s = 1;
+  const std::vector<BenchmarkRow> rows = {score_run("a,b \"c\"", "x", hand_truth(), a),
+                                          score_run("d|e", "x", hand_truth(), a)};
+  const std::vector<BenchmarkRow> means = tracker_means(rows, {"x"});
+  const std::vector<std::string> csv = lines_of(format_benchmark_csv(rows, means));
+  EXPECT_EQ(csv[1].rfind("\"a,b \"\"c\"\"\",x,1,", 0), 0u) << csv[1];
+  const std::string md = format_benchmark_markdown(rows, means);
+  EXPECT_NE(md.find("| d\\|e | 0.952 |"), std::string::npos) << md;
+}
+
 TEST(OtbBenchmarkTest, TinyTlpGroundTruthHasSixColumnsAndAnAbsentFlag) {
   const std::vector<cv::Rect2f> boxes =
       parse_ground_truth("1,495,343,172,109,0\n2,496,344,170,108,1\n3 497 345 171 110 0\n", "tlp");

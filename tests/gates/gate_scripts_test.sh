@@ -165,6 +165,68 @@ expect fail "mot gate, ground truth of 700 frames" mgate
 cp "$work/gt_full.txt" "$mgt"
 expect pass "mot gate, good again" mgate
 
+# --- dropin_gate.sh: a stub roiflow (track copies $work/dcli.csv to --log; batch prints
+# $work/batch<N>.txt and writes $work/batch.csv into --out) and a stub gst-launch-1.0 (copies
+# $work/dgst.csv to log=); `score` is the real roiflow.
+ddata="$work/ddata"
+mkdir -p "$ddata/video" "$work/dstub"
+: >"$ddata/video/opencv_vtest.avi"
+cat >"$work/dstub/roiflow" <<STUB
+#!/usr/bin/env bash
+case \$1 in
+  track)
+    while [[ \$# -gt 0 ]]; do [[ \$1 == --log ]] && cp "$work/dcli.csv" "\$2"; shift; done
+    exit 0 ;;
+  batch)
+    while [[ \$# -gt 0 ]]; do [[ \$1 == --out ]] && out=\$2; shift; done
+    n=\$(cat "$work/batch_runs" 2>/dev/null || echo 0); n=\$((n + 1)); echo \$n >"$work/batch_runs"
+    mkdir -p "\$out/clip_a" "\$out/clip_b"
+    cp "$work/dbatch.csv" "\$out/batch.csv"
+    cp "$work/dlog.csv" "\$out/clip_a/track.csv"; cp "$work/dlog.csv" "\$out/clip_b/track.csv"
+    cat "$work/batch\$n.txt"; exit 0 ;;
+esac
+exec "$real_bin" "\$@"
+STUB
+cat >"$work/dstub/gst-launch-1.0" <<STUB
+#!/usr/bin/env bash
+for a in "\$@"; do [[ \$a == log=* ]] && cp "$work/dgst.csv" "\${a#log=}"; done
+exit 0
+STUB
+chmod +x "$work/dstub/roiflow" "$work/dstub/gst-launch-1.0"
+dlog() {  # dlog FILE ROWS [ROW_TO_SHIFT]
+  echo "frame,x,y,w,h,vx,vy,mode,lost,ms" >"$1"
+  for ((i = 1; i <= $2; ++i)); do
+    x=$((10 + i % 50))
+    [[ $i == "${3:-0}" ]] && x=400
+    echo "$i,$x,20,30,40,0,0,local,0,0.$((i % 7))" >>"$1"
+  done
+}
+dbatch() {  # dbatch FPS_OF_B
+  printf 'video,status,frames,fps,seconds\nv/clip_a.avi,done,750,500.0,1.5\nv/clip_b.avi,done,750,%s,1.5\n' "$1" >"$work/dbatch.csv"
+}
+dreset() {
+  rm -f "$work/batch_runs"
+  dlog "$work/dcli.csv" 795
+  dlog "$work/dgst.csv" 795
+  dlog "$work/dlog.csv" 750
+  dbatch 400.0
+  echo "batch: 2 videos: 2 run, 0 already done, 0 failed; wrote x" >"$work/batch1.txt"
+  echo "batch: 2 videos: 0 run, 2 already done, 0 failed; wrote x" >"$work/batch2.txt"
+}
+dgate() { GST_LAUNCH="$work/dstub/gst-launch-1.0" "$repo/scripts/dropin_gate.sh" "$ddata" "$work/dstub"; }
+dreset
+expect pass "dropin gate, good figures" dgate
+dreset; dlog "$work/dgst.csv" 795 300
+expect fail "dropin gate, the element's log differs in one row" dgate
+dreset; dlog "$work/dgst.csv" 790
+expect fail "dropin gate, the element's log is short" dgate
+dreset; echo "batch: 2 videos: 1 run, 1 already done, 0 failed; wrote x" >"$work/batch2.txt"
+expect fail "dropin gate, the second batch run did work" dgate
+dreset; dbatch nan
+expect fail "dropin gate, nan fps in batch.csv" dgate
+dreset; dlog "$work/dlog.csv" 749
+expect fail "dropin gate, a track log one row short of batch.csv" dgate
+
 # --- test.sh under CI without the data: a copy of scripts/ with no ../shared/data beside it,
 # and a build step that does nothing (the suite itself is not what is checked here).
 ci="$work/ci/repo"

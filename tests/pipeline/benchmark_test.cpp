@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "eval/otb_score.hpp"
+#include "eval/track_log.hpp"
 #include "otb_test_tree.hpp"
 #include "test_util.hpp"
 
@@ -132,6 +134,32 @@ TEST_F(BenchmarkTest, WritesTheTablesAndPlots) {
   }
   for (const auto& e : fs::directory_iterator(path("out/nested")))
     EXPECT_EQ(e.path().filename().string().find(".partial"), std::string::npos);
+  EXPECT_FALSE(fs::exists(path("out/nested/tracks")));
+
+  // With tracks: every run's log, which scores like its row (to the log's 2-decimal rounding).
+  const std::vector<std::string> with_tracks = write_benchmark(r, path("out/t"), true);
+  ASSERT_EQ(with_tracks.size(), 5u);
+  EXPECT_EQ(with_tracks[4], path("out/t/tracks"));
+  ASSERT_EQ(r.runs.size(), r.rows.size());
+  for (std::size_t i = 0; i < r.rows.size(); ++i) {
+    const eval::BenchmarkRow& row = r.rows[i];
+    SCOPED_TRACE(row.sequence + " " + row.tracker);
+    const std::vector<eval::TrackRecord> log =
+        eval::read_track_csv(path("out/t/tracks/" + row.sequence + "/" + row.tracker + ".csv"));
+    ASSERT_EQ(static_cast<long long>(log.size()), row.frames);
+    EXPECT_EQ(log[0].box, r.runs[i].boxes[0]);
+    long long lost = 0;
+    double ms = 0;
+    for (const eval::TrackRecord& rec : log) {
+      lost += rec.lost ? 1 : 0;
+      ms += rec.ms;
+    }
+    EXPECT_EQ(lost, row.lost);
+    EXPECT_NEAR(ms / 1000.0, row.cpu_s, 1e-3 * row.frames);  // ms to 3 decimals per frame
+    const std::vector<cv::Rect2f> truth =
+        eval::read_ground_truth(path("set/" + row.sequence + "/groundtruth_rect.txt"));
+    EXPECT_NEAR(eval::score(eval::track_boxes(log), truth).auc, row.auc, 0.01);
+  }
 }
 
 TEST_F(BenchmarkTest, BadInputFailsBeforeAnyTrackerRuns) {
