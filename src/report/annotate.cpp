@@ -202,7 +202,8 @@ cv::Mat annotate_objects(const cv::Mat& image, const ObjectsAnnotation& frame,
     AnnotateStyle arrow_style = style;
     arrow_style.arrow_color = color;
     draw_velocity(canvas, arrow, arrow_style);
-    const std::string label = "#" + std::to_string(o.id);
+    std::string label = "#";  // appended, not "#" + ...: GCC 12 warns falsely (-Wrestrict)
+    label += std::to_string(o.id);
     int baseline = 0;
     const cv::Size size = cv::getTextSize(label, font, scale, 1, &baseline);
     const cv::Point at(std::clamp(box->x, 0, std::max(0, canvas.cols - size.width)),
