@@ -51,7 +51,7 @@ def check_complete(folder):
     status = json.loads((folder / "status.json").read_text())
     assert status["status"] == "done"
     rows = (folder / "track.csv").read_text().splitlines()
-    assert rows[0] == "frame,x,y,w,h,vx,vy,mode,lost,ms"
+    assert rows[0] == "frame,id,x,y,w,h,vx,vy,mode,lost,ms"
     assert len(rows) == status["frames"] + 1
     assert [int(r.split(",")[0]) for r in rows[1:]] == list(range(1, status["frames"] + 1))
     return status

@@ -5,6 +5,7 @@
 #include <map>
 #include <opencv2/imgproc.hpp>
 #include <set>
+#include <sstream>
 
 #include "mot_scene.hpp"
 #include "stages/motion_detector.hpp"
@@ -67,11 +68,10 @@ TEST(MotionDetector, FindsEveryMovingObject) {
     for (const stages::Detection& d : found)
       if (test::box_iou(d.box, scene.box(static_cast<std::size_t>(i), last)) > 0.5) ++matched;
   }
-  std::string boxes;
+  std::ostringstream boxes;
   for (const stages::Detection& d : found)
-    boxes += " " + std::to_string(d.box.x) + "," + std::to_string(d.box.y) + "," +
-             std::to_string(d.box.width) + "," + std::to_string(d.box.height);
-  EXPECT_EQ(matched, 3) << boxes;
+    boxes << " " << d.box;
+  EXPECT_EQ(matched, 3) << boxes.str();
 }
 
 TEST(DetectObjects, SplitsNeighboursAtTheValleyBetweenThem) {
@@ -90,10 +90,10 @@ TEST(DetectObjects, SplitsNeighboursAtTheValleyBetweenThem) {
   std::sort(found.begin(), found.end(), [](const stages::Detection& a, const stages::Detection& b) {
     return a.box.x < b.box.x;
   });
-  std::string got;
+  std::ostringstream got;
   for (const auto& d : found)
-    got += " " + std::to_string(d.box.x) + "," + std::to_string(d.box.width);
-  ASSERT_EQ(found.size(), 3u) << got;
+    got << " " << d.box;
+  ASSERT_EQ(found.size(), 3u) << got.str();
   EXPECT_EQ(found[0].box, cv::Rect2f(20, 20, 16, 50));
   EXPECT_EQ(found[1].box, cv::Rect2f(36, 22, 19, 50));  // from the valley on
   EXPECT_EQ(found[2].box, cv::Rect2f(120, 20, 40, 30));
@@ -188,15 +188,6 @@ TEST(MultiTracker, KeepsIdsThroughACrossing) {
   // frames, where LK keeps them apart.
   MotScene scene({320, 200}, {{{40, 80, 22, 46}, {3, 0}, 8}, {{258, 84, 22, 46}, {-3, 0}, 8}});
   const auto found = run(scene, 80);
-  if (std::getenv("MOT_TEST_DEBUG")) {
-    for (int t = 0; t < 80; ++t) {
-      std::string line = std::to_string(t) + ":";
-      for (const auto& [id, b] : found[static_cast<std::size_t>(t)])
-        line +=
-            " " + std::to_string(id) + "@" + std::to_string(b.x) + "," + std::to_string(b.width);
-      std::printf("%s   truth %.0f %.0f\n", line.c_str(), scene.box(0, t).x, scene.box(1, t).x);
-    }
-  }
   const std::vector<Coverage> c = coverage(scene, found, 30);
   for (std::size_t i = 0; i < c.size(); ++i) {
     EXPECT_EQ(c[i].ids.size(), 1u) << "object " << i;
