@@ -29,6 +29,7 @@
 #include "eval/tracking_scene.hpp"
 #include "flow/color_code.hpp"
 #include "pipeline/frame_graph.hpp"
+#include "pipeline/mot_run.hpp"
 #include "pipeline/tbb_executor.hpp"
 #include "report/annotate.hpp"
 #include "report/plot.hpp"
@@ -204,7 +205,11 @@ struct SourceOptions {
 struct TrackCommand {
   LkOptions lk;
   std::string input;
-  std::string init;
+  std::string init;                // the single --init (single-object tracker)
+  std::vector<std::string> inits;  // every --init
+  std::string init_file;           // --init-file: id,x,y,w,h lines
+  std::string mot;                 // --mot: MOTChallenge output
+  bool single = false;             // --single: one object even without --init
   int roi = 50;
   double lk_patches = stages::LocalTrackerParams{}.lk_patches;
   std::string mode = "local";
@@ -384,6 +389,7 @@ std::vector<std::string> child_args(const TrackCommand& cmd, const std::string& 
                                 "--threads",
                                 std::to_string(cmd.lk.threads)};
   if (!cmd.init.empty()) a.insert(a.end(), {"--init", cmd.init});
+  a.push_back("--single");
   const LkOptions& lk = cmd.lk;
   if (lk.levels) a.insert(a.end(), {"--levels", *lk.levels});
   if (lk.expected_motion) a.insert(a.end(), {"--expected-motion", exact(*lk.expected_motion)});
@@ -723,7 +729,81 @@ int run_compare(const TrackCommand& cmd) {
   return 0;
 }
 
-int run_track(const TrackCommand& cmd) {
+// Every moving object (no --init, several, or --init-file): the multi-object graph.
+int run_track_objects(const TrackCommand& cmd) {
+  pipeline::MotRunOptions o;
+  for (const std::string& text : cmd.inits) {
+    const cv::Rect2f box = parse_box(text, "--init");
+    o.params.known.push_back({static_cast<long long>(o.params.known.size()) + 1, box});
+  }
+  if (!cmd.init_file.empty()) {
+    if (!cmd.inits.empty())
+      throw UsageError("--init-file: give the targets either there or by --init");
+    try {
+      o.params.known = stages::read_known_targets(cmd.init_file);
+    } catch (const Error& e) {
+      throw UsageError(std::string("--init-file: ") + e.what());
+    }
+  }
+  o.params.births = o.params.known.empty();
+  o.params.lk = lk_params(cmd.lk);
+  try {
+    o.params.validate();
+  } catch (const Error& e) {
+    throw UsageError(e.what());
+  }
+  if (!cmd.log.empty()) check_log_path(cmd.log);
+  if (!cmd.mot.empty()) check_output_path(cmd.mot, "--mot");
+  if (!cmd.out.video.empty()) check_output_path(cmd.out.video, "--out");
+  if (!cmd.out.summary.empty()) check_summary_path(cmd.out.summary);
+  stages::VideoSource source(cmd.input, cmd.source.params());
+  const cv::Rect2f frame(0.f, 0.f, static_cast<float>(source.size().width),
+                         static_cast<float>(source.size().height));
+  for (const stages::KnownTarget& k : o.params.known) {
+    const cv::Rect2f inside = k.box & frame;
+    if (inside.width < 2 || inside.height < 2)
+      throw UsageError("target " + std::to_string(k.id) + " lies outside the " +
+                       size_string(source.size()) + " frame");
+  }
+  o.log = cmd.log;
+  o.mot = cmd.mot;
+  o.video = cmd.out.video;
+  o.threads = cmd.lk.threads;
+  o.in_flight = cmd.source.in_flight;
+  o.progress = cmd.out.progress;
+  o.frame_hint = source.frame_count_hint();
+  o.cancel = &g_cancel;
+  SignalScope signals;
+  pipeline::MotRun run =
+      pipeline::track_objects([&] { return source.next(); }, source.size(), source.fps(), o);
+  const Ending end = ending(run.report, &source.status());
+  run.summary["input"] = source.description();
+  run.summary["status"] = end.message.empty() ? source.status().message : end.message;
+  std::vector<std::string> written;
+  for (const std::string* path : {&cmd.log, &cmd.mot, &cmd.out.video})
+    if (!path->empty()) written.push_back(*path);
+  if (!cmd.out.summary.empty()) {
+    write_text_atomically(cmd.out.summary, run.summary.dump(2) + "\n");
+    written.push_back(cmd.out.summary);
+  }
+  print_track_summary("track " + source.description(), run.summary, written);
+  std::cout << "  objects born " << run.summary.at("objects_born").get<long long>() << ", ended "
+            << run.summary.at("objects_ended").get<long long>() << ", at most "
+            << run.summary.at("most_objects").get<long long>() << " at once\n";
+  if (end.exit_code != 0) std::cerr << "roiflow: error: " << end.message << "\n";
+  return end.exit_code;
+}
+
+int run_track(TrackCommand& cmd) {
+  cmd.init = cmd.inits.size() == 1 ? cmd.inits.front() : std::string();
+  const bool objects = !cmd.compare && !cmd.single && cmd.mode == "local" &&
+                       (cmd.inits.size() != 1 || !cmd.init_file.empty());
+  if (objects) return run_track_objects(cmd);
+  if (cmd.inits.size() > 1 || !cmd.init_file.empty())
+    throw UsageError(
+        "several targets (--init twice, --init-file) need --mode local without "
+        "--single or --compare");
+  if (!cmd.mot.empty()) throw UsageError("--mot needs the multi-object tracker (not --single)");
   if (cmd.compare) return run_compare(cmd);
   const stages::TrackerParams params = tracker_params(cmd);
   if (!cmd.log.empty()) check_log_path(cmd.log);
@@ -781,10 +861,19 @@ void add_track_command(CLI::App& app, TrackCommand& cmd, int& exit_code) {
                   "video file, image-sequence folder (OTB img/), camera index, or "
                   "synthetic:N[:WxH] (a generated stream of N frames, for soak runs)")
       ->required();
-  sub->add_option("--init", cmd.init,
-                  "the target's box in the first frame, x,y,w,h (OTB protocol); without it the "
-                  "global treatment finds the moving object")
-      ->type_name("X,Y,W,H");
+  sub->add_option("--init", cmd.inits,
+                  "a target's box in the first frame, x,y,w,h (OTB protocol); once: the "
+                  "single-object tracker; repeated: those targets (ids 1, 2, ...); without it "
+                  "every moving object is found and followed (fixed camera)")
+      ->type_name("X,Y,W,H")
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  sub->add_option("--init-file", cmd.init_file, "known targets, one id,x,y,w,h line each")
+      ->type_name("FILE");
+  sub->add_option("--mot", cmd.mot,
+                  "every object's boxes in MOTChallenge format (frame,id,x,y,w,h,conf,-1,-1,-1)")
+      ->type_name("FILE");
+  sub->add_flag("--single", cmd.single,
+                "follow one object (the paper's single-object tracker) even without --init");
   sub->add_option("--roi", cmd.roi, "side of the local region in pixels")
       ->check(CLI::Range(8, 4096))
       ->capture_default_str();
