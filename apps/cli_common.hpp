@@ -50,6 +50,8 @@ void add_video_commands(CLI::App& app, int& exit_code);
 void add_sweep_command(CLI::App& app);      // roiflow sweep (sweep_command.cpp)
 void add_benchmark_command(CLI::App& app);  // roiflow benchmark (benchmark_command.cpp)
 void add_scaling_command(CLI::App& app);    // roiflow scaling (scaling_command.cpp)
+// roiflow demo --objects N (mot_demo_command.cpp); returns the exit code.
+int run_objects_demo(const std::string& dir, int objects, int frames, int threads, bool progress);
 // roiflow score --mot PRED GT (mot_score_command.cpp)
 void print_mot_score(const std::string& pred, const std::string& gt, const std::string& format);
 

@@ -1013,9 +1013,15 @@ struct DemoCommand {
   int frames = 150;
   int threads = 0;
   bool progress = true;
+  int objects = 0;            // > 0: the multi-object traffic demo (mot_demo_command.cpp)
+  bool frames_given = false;  // --frames was given (the traffic demo's default is 300)
 };
 
 int run_demo(const DemoCommand& cmd) {
+  if (cmd.objects > 0) {
+    return run_objects_demo(cmd.dir, cmd.objects, cmd.frames_given ? cmd.frames : 300,
+                            cmd.threads > 0 ? cmd.threads : default_threads(), cmd.progress);
+  }
   fs::create_directories(cmd.dir);
   eval::TrackingSceneParams scene_params;
   scene_params.frames = cmd.frames;
@@ -1108,13 +1114,21 @@ void add_demo_command(CLI::App& app, DemoCommand& cmd, int& exit_code) {
       "demo",
       "Track a vehicle in a built-in synthetic video (no input needed) and print the error");
   sub->add_option("--dir", cmd.dir, "where the video, log and summary go")->capture_default_str();
-  sub->add_option("--frames", cmd.frames, "length of the scene")
-      ->check(CLI::Range(3, 100000))
-      ->capture_default_str();
+  CLI::Option* frames =
+      sub->add_option("--frames", cmd.frames, "length of the scene (with --objects: default 300)")
+          ->check(CLI::Range(3, 100000))
+          ->capture_default_str();
+  sub->add_option("--objects", cmd.objects,
+                  "track N vehicles of the synthetic traffic scene instead; writes mot.txt and "
+                  "gt_mot.txt, prints MOTA and IDF1")
+      ->check(CLI::Range(1, 256));
   sub->add_option("--threads", cmd.threads, "worker threads (0 = all)")
       ->check(CLI::Range(0, pipeline::kMaxThreads));
   sub->add_flag("!--no-progress", cmd.progress, "no progress bar on the terminal");
-  sub->callback([&cmd, &exit_code] { exit_code = run_demo(cmd); });
+  sub->callback([&cmd, &exit_code, frames] {
+    cmd.frames_given = frames->count() > 0;
+    exit_code = run_demo(cmd);
+  });
 }
 
 }  // namespace
