@@ -11,7 +11,7 @@ cd "$(dirname "$0")/.."
 source scripts/gate_lib.sh
 dir=$1
 bin=${2:-build/release}/roiflow
-min_auc=0.80        # measured on Car4: 0.872
+min_auc=0.85        # measured on Car4: 0.855 (issue 20 asks >= 0.85)
 min_precision=0.98  # measured on Car4: 1.000
 truth="$dir/groundtruth_rect.txt"
 [[ -f $truth ]] || gate_fail "$truth not found"

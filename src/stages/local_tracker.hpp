@@ -41,6 +41,14 @@
 // by the measured displacement (an alpha-beta filter with alpha = 1: the reported box is the
 // measurement).
 //
+// Self-awareness (docs/TRACKING.md): the object's motion comes from the pixels that move unlike
+// the background (measured on a ring around the box), and the step checks for states that cannot
+// be right — a forward-backward error that is high, a size change no object makes, a box as large
+// as the frame, a box that moves with the background right after the target moved unlike it, a
+// look that matches none of the target's (first, recent, remembered) — and declares the target
+// lost (LostReason says which). While lost, the box coasts and the appearance is searched over a
+// widening window around it; only a confident match takes the target back.
+//
 // The object is lost when too few of its pixels pass the forward-backward check or its box has
 // too little texture (unless the appearance, searched over twice the radius around the
 // prediction, still matches well: a sudden change of lighting breaks LK's brightness constancy,
@@ -99,7 +107,28 @@ struct LocalTrackerParams {
                                    // only from confidently tracked frames), >= 1
   double velocity_gain = 0.5;      // share of the prediction error that corrects the velocity,
                                    // [0, 1]
-  void validate() const;           // throws roiflow::Error naming the bad value
+  // Self-awareness and non-rigid targets (docs/TRACKING.md, "Knowing when it is lost").
+  bool segment = true;                // the target's motion from the pixels that move unlike the
+                                      // background (measured on a ring around the box)
+  double foreground_tolerance = 1.0;  // pixels of the LK level by which a pixel's flow must differ
+                                      // from the background's to move with the target, > 0
+  double max_fb_error = 4;       // the flow fails when the median forward-backward error of the
+                                 // object's pixels exceeds this many pixels of the LK level, > 0
+  double max_frame_share = 0.9;  // lost when a side of the box exceeds this share of the
+                                 // frame's, (0, 1]
+  double moving_speed = 1.5;     // the target "was moving" when its recent speed relative to the
+                                 // background is above this (pixels per frame), > 0
+  double stop_share = 0.25;      // ... and it is taken to have latched onto the background when
+                                 // its speed relative to it drops below this share of that
+                                 // recent speed at once, with no pixel moving unlike it, [0, 1)
+  double confident_appearance = 0.6;  // the appearance memory is refreshed only from frames whose
+                                      // NCC reaches this, [trust_appearance, 1]
+  int memory = 4;            // earlier looks kept besides the first (long-term memory), 0..16
+  int memory_interval = 25;  // confident frames between two looks kept, >= 1
+  double coast_decay = 0.9;  // velocity kept per frame while lost (coasting), [0, 1]
+  double max_reach = 8;      // while lost, the appearance search around the coasting box widens
+                             // from 2 to this many times `search`, 2..100
+  void validate() const;     // throws roiflow::Error naming the bad value
 };
 
 // One frame for the local treatment.
@@ -111,7 +140,18 @@ struct LocalFrame {
 };
 
 // Why a frame's result is lost (Found when it is not).
-enum class LostReason { Found, FewInliers, LowTexture, Appearance, LeftRegion };
+enum class LostReason {
+  Found,
+  FewInliers,  // too few pixels pass the forward-backward check
+  LowTexture,  // nothing in the box for LK to hold on to
+  Appearance,  // the box matches none of the target's looks (first, recent, remembered)
+  LeftRegion,  // the measured centre left the local region
+  FbError,     // the median forward-backward error is high
+  ScaleJump,   // the box grows or shrinks faster between two frames than any object does
+  TooLarge,    // the box is (nearly) as large as the frame
+  Background,  // the box moves with the background right after the target moved unlike it
+  Searching    // lost before, and not yet found again by appearance
+};
 const char* to_string(LostReason reason);
 
 struct LocalResult {
@@ -126,6 +166,10 @@ struct LocalResult {
   double appearance = -1;  // best NCC against the template, -1 when it was not measured
   double scale = 1;        // size change this frame (1 = none)
   int level = 0;           // the pyramid level LK ran on (see lk_patches)
+  double fb_error = 0;     // median forward-backward error of the object's pixels (level-0 px)
+  bool background_known = false;  // the ring around the box gave the background's motion
+  cv::Point2f background;         // its motion (median flow of the ring), pixels per frame
+  double foreground = 0;          // share of the inliers that move unlike the background
 };
 
 class LocalTracker {
@@ -147,6 +191,12 @@ class LocalTracker {
   // Places the object again (after a re-detection) keeping the appearance captured by start().
   void restart(const LocalFrame& frame, const cv::Rect2f& box);
   bool started() const;
+  // Best NCC of the target's looks (first, recent, remembered) around `box` in `frame`, at a few
+  // scales: how well a re-detection there matches; -1 when nothing could be matched. Does not
+  // change the state.
+  double verify(const LocalFrame& frame, const cv::Rect2f& box);
+  // Whether the last track() left the target lost (the box coasts until it is found again).
+  bool lost() const;
 
   // Follows the object from the previous frame to `frame` (same size as the previous one,
   // else roiflow::Error). Throws roiflow::Error when not started.

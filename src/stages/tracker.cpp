@@ -143,6 +143,19 @@ void TrackerParams::validate() const {
     throw Error("tracker: observe_interval must be in 1..1000, got " +
                 std::to_string(observe_interval));
   }
+  if (!(verify >= -1 && verify <= 1)) {
+    throw Error("tracker: verify must be in [-1, 1], got " + number_text(verify));
+  }
+  if (!(reach_growth >= 0 && reach_growth <= 10)) {
+    throw Error("tracker: reach_growth must be in [0, 10], got " + number_text(reach_growth));
+  }
+  if (redetect_interval < 1 || redetect_interval > 1000) {
+    throw Error("tracker: redetect_interval must be in 1..1000, got " +
+                std::to_string(redetect_interval));
+  }
+  if (!(verify_far >= verify && verify_far <= 1)) {
+    throw Error("tracker: verify_far must be in [verify, 1], got " + number_text(verify_far));
+  }
   if (!(held_learning > 0 && held_learning <= 1)) {
     throw Error("tracker: held_learning must be in (0, 1], got " + number_text(held_learning));
   }
@@ -168,6 +181,8 @@ struct Tracker::Impl {
   bool has_target = false;
   bool lost = false;
   bool camera_moves = false;
+  cv::Rect2f last_held;       // the target's box the last time the local treatment held it
+  long long frames_lost = 0;  // frames lost in a row
   long long activations = 0;
   long long observed_index = -1;  // the last frame given to the background model
 
@@ -244,6 +259,7 @@ void Tracker::Impl::acquire(const TrackerInput& frame, TrackerOutput& out) {
     }
     detector.set_target(image, b);
     local.start({frame.gray, frame.pyramid}, b);
+    last_held = b;
     if (params.mode == TrackMode::Global) ++activations;
     out.mode =
         params.mode == TrackMode::Global ? TrackRecord::Mode::Global : TrackRecord::Mode::Local;
@@ -262,6 +278,7 @@ void Tracker::Impl::acquire(const TrackerInput& frame, TrackerOutput& out) {
     }
     detector.set_target(image, box);
     local.start({frame.gray, frame.pyramid}, box);
+    last_held = box;
     out.box = box;
   }
   has_target = true;
@@ -282,11 +299,16 @@ void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double
     const double bg = background_motion(r.region_flow, r.region, before);
     if (bg >= 0) camera_moves = bg > params.camera_motion;
   }
+  out.reason = r.reason;
   if (!r.lost) {
     lost = false;
+    frames_lost = 0;
+    last_held = r.box;
     out.box = r.box;
     out.velocity = r.velocity;
-    detector.set_target_size(r.box.size());
+    // Only a confident frame tells the re-detection the target's size: a drifting box would
+    // have it search at the drift's scale.
+    if (r.appearance >= params.local.trust_appearance) detector.set_target_size(r.box.size());
     return;
   }
   // Lost: the global treatment searches the whole frame; until it succeeds the box coasts.
@@ -296,15 +318,40 @@ void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double
   const cv::Mat image = frame.picture();
   observe(frame);
   const bool by_appearance = params.init.has_value() || camera_moves;
+  // The whole-frame search costs tens of local steps on a large frame: while the target stays
+  // lost it runs on the first lost frame and then every redetect_interval frames (the local
+  // treatment searches around the coasting box every frame).
+  const bool search = (frames_lost % params.redetect_interval == 0);
   const std::optional<Detection> found =
-      detector.find_target(image, frame.gray, centre(r.box), by_appearance);
-  if (found) {
+      search ? detector.find_target(image, frame.gray, centre(r.box), by_appearance) : std::nullopt;
+  // A re-detection is verified against every look the local treatment keeps (first, recent,
+  // remembered) at a finer level before the target is placed there again.
+  const double ver = found && found->box.width >= 2 && found->box.height >= 2
+                         ? local.verify({frame.gray, frame.pyramid}, found->box)
+                         : -2;
+  // Objects do not jump: a re-detection far from where the target was last held is taken only
+  // when its look is unmistakable; near it (a distance that grows while the target stays lost)
+  // a good one suffices.
+  const cv::Rect2f frame_box(0.f, 0.f, static_cast<float>(size.width),
+                             static_cast<float>(size.height));
+  const cv::Rect2f seen = found ? found->box & frame_box : cv::Rect2f();
+  bool accept = found && seen.width >= 4 && seen.height >= 4 && ver >= params.verify;
+  if (accept && ver < params.verify_far) {
+    const cv::Point2f d = centre(found->box) - centre(last_held);
+    const float reach =
+        std::max(last_held.width, last_held.height) *
+        (1.5f + static_cast<float>(params.reach_growth) * static_cast<float>(frames_lost));
+    accept = d.dot(d) <= reach * reach;
+  }
+  if (accept) {
     local.restart({frame.gray, frame.pyramid}, found->box);
+    out.reason = LostReason::Found;
     lost = false;
     out.box = found->box;
     return;
   }
   lost = true;
+  ++frames_lost;
   out.lost = true;
   out.box = r.box;
   out.velocity = r.velocity;

@@ -80,6 +80,16 @@ struct TrackerParams {
   // its history), so that a slow target it sees in every refresh is not learnt into the
   // background. (0, 1].
   double held_learning = 0.25;
+  // A re-detection of a lost target is accepted when one of the target's looks matches it with
+  // at least this NCC (LocalTracker::verify), [-1, 1].
+  double verify = 0.65;
+  // ... and far from where it was last held (beyond 1.5 box sides, growing by reach_growth
+  // sides a frame lost) only from this NCC on, [verify, 1].
+  double verify_far = 0.9;
+  // How fast "near" grows while the target stays lost: box sides per frame, [0, 10].
+  double reach_growth = 0.05;
+  // While the target stays lost, the whole-frame search runs every this many frames, 1..1000.
+  int redetect_interval = 1;
   GlobalDetectorParams detector;
   void validate() const;  // throws roiflow::Error naming the bad value
 };
@@ -107,8 +117,9 @@ struct TrackerOutput {
   cv::Rect2f box;           // the target's box in this frame (valid when has_target)
   cv::Point2f velocity;     // pixels per frame, corrected estimate
   TrackRecord::Mode mode = TrackRecord::Mode::Global;  // the treatment that produced the box
-  bool lost = false;    // the target was not found in this frame (box = prediction)
-  cv::Rect region;      // where LK ran for this frame (empty when it did not run)
+  bool lost = false;  // the target was not found in this frame (box = prediction)
+  LostReason reason = LostReason::Found;  // why the local treatment lost it (Found when it did not)
+  cv::Rect region;                        // where LK ran for this frame (empty when it did not run)
   cv::Mat region_flow;  // CV_32FC2 flow over `region` (t-1 -> t), for annotation; may be empty
   double ms = 0;        // time process() took
   long long global_activations = 0;  // running count, this frame included
