@@ -27,3 +27,4 @@ fi
 scripts/eval_gate.sh "$data"
 scripts/track_gate.sh "$data/tracking/Car4"
 scripts/benchmark_gate.sh "$data/tracking"
+scripts/mot_demo_gate.sh  # synthetic traffic, no data needed; runs with the other gates

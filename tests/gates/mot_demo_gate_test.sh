@@ -49,11 +49,14 @@ gt() {
     echo "$f,2,100,10,20,20,1,-1,-1,-1" >>"$work/case/gt_mot.txt"
   done
 }
-pred() {  # pred MISSED
+pred() {  # pred MISSED [STRAYS]: object 2 missed in frames 1..MISSED, STRAYS stray boxes a frame
   : >"$work/case/mot.txt"
   for ((f = 1; f <= 10; ++f)); do
     echo "$f,7,10,10,20,20,1,-1,-1,-1" >>"$work/case/mot.txt"
     ((f <= $1)) || echo "$f,8,100,10,20,20,1,-1,-1,-1" >>"$work/case/mot.txt"
+    for ((k = 0; k < ${2:-0}; ++k)); do
+      echo "$f,$((20 + k)),$((300 + 40 * k)),300,20,20,1,-1,-1,-1" >>"$work/case/mot.txt"
+    done
   done
 }
 summary() { printf '{\n  "frames": 10,\n  "mota": %s,\n  "idf1": %s\n}\n' "$1" "$2" >"$work/case/summary.json"; }
@@ -71,10 +74,15 @@ printf '{"frames": 10, "mota": 1.0}\n' >"$work/case/summary.json"
 expect fail "mot demo gate, idf1 missing" gate
 summary 0.95 1.0
 expect fail "mot demo gate, summary mota not what its files score" gate
-# Object 2 missed in 3 of 10 frames: MOTA 1 - 3/20 = 0.85, IDF1 2*17/(20+17) = 0.9189.
-pred 3
-summary 0.85 0.918918918918919
+# Object 2 missed in all 10 frames and 4 stray boxes a frame: MOTA 1 - (10 + 40)/20 = -1.5,
+# IDF1 2*10/(20+50) = 0.2857: below the MOTA floor.
+pred 10 4
+summary -1.5 0.285714285714286
 expect fail "mot demo gate, MOTA below its floor" gate
+# Everything missed but object 1 in frame 1: IDF1 2*1/(20+1) = 0.095, below its floor.
+printf '1,7,10,10,20,20,1,-1,-1,-1\n' >"$work/case/mot.txt"
+summary 0.05 0.0952380952380952
+expect fail "mot demo gate, IDF1 below its floor" gate
 rm "$work/case/gt_mot.txt"
 pred 0
 summary 1.0 1.0
