@@ -7,9 +7,9 @@
 #include <fstream>
 #include <iterator>
 #include <memory>
-#include <set>
 #include <nlohmann/json.hpp>
 #include <opencv2/videoio.hpp>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -98,9 +98,9 @@ TEST_F(CompareCliTest, RunsBothModesAndWritesTableCsvJsonAndPlots) {
   std::set<std::string> names;
   for (const auto& entry : fs::directory_iterator(dir))
     names.insert(entry.path().filename().string());
-  EXPECT_EQ(names, (std::set<std::string>{"compare.csv", "compare.json", "global.csv",
-                                          "global.json", "local.csv", "local.json",
-                                          "ms_per_frame.svg", "patches.svg"}));
+  EXPECT_EQ(names,
+            (std::set<std::string>{"compare.csv", "compare.json", "global.csv", "global.json",
+                                   "local.csv", "local.json", "ms_per_frame.svg", "patches.svg"}));
 }
 
 TEST_F(CompareCliTest, BadCommandLinesFailWithOneLine) {
