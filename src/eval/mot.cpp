@@ -15,6 +15,7 @@
 #include "core/error.hpp"
 #include "core/text.hpp"
 #include "core/text_file.hpp"
+#include "eval/line_error_impl.hpp"
 
 namespace roiflow::eval {
 namespace {
@@ -25,14 +26,7 @@ constexpr double kIouGate = kIouThreshold - std::numeric_limits<double>::epsilon
 constexpr int kDistractorClasses[] = {2, 7, 8, 12};
 constexpr int kPedestrian = 1;
 
-class LineError {
- public:
-  LineError(const std::string& path, long long line) : prefix_(path + ":" + std::to_string(line)) {}
-  [[noreturn]] void fail(const std::string& what) const { throw Error(prefix_ + ": " + what); }
-
- private:
-  std::string prefix_;
-};
+using detail::LineError;
 
 std::string_view trim(std::string_view s) {
   while (!s.empty() && (s.front() == ' ' || s.front() == '\t'))

@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 #include "core/text.hpp"
 #include "core/text_file.hpp"
+#include "eval/line_error_impl.hpp"
 
 namespace roiflow::eval {
 namespace {
@@ -33,14 +34,7 @@ double rounded(double value, int decimals) {
 
 // --- reading ---------------------------------------------------------------------------------
 
-class LineError {
- public:
-  LineError(const std::string& path, long long line) : prefix_(path + ":" + std::to_string(line)) {}
-  [[noreturn]] void fail(const std::string& what) const { throw Error(prefix_ + ": " + what); }
-
- private:
-  std::string prefix_;
-};
+using detail::LineError;
 
 std::vector<std::string_view> split_commas(std::string_view line) {
   std::vector<std::string_view> fields;
