@@ -63,10 +63,15 @@ void TbbExecutor::for_range(int begin, int end, int grain,
   // flow core's per-stripe setup. `grain` stays a floor, not the chunk size.
   // Isolated: while this thread waits for its stripes it must not pick up another node's task
   // (a frame to decode, a pyramid), which would hold up the serial node it is running for.
+  // Its own isolated task_group_context: a graph that is being cancelled (another node threw)
+  // must not silently skip some stripes of a pass already running, which would leave a result
+  // half computed and the stripes' waits on a cancelled tree. An exception from `body` still
+  // propagates from parallel_for.
   tbb::this_task_arena::isolate([&] {
+    tbb::task_group_context stripes(tbb::task_group_context::isolated);
     tbb::parallel_for(
         range, [&body](const tbb::blocked_range<int>& r) { body(r.begin(), r.end()); },
-        tbb::auto_partitioner());
+        tbb::auto_partitioner(), stripes);
   });
 }
 
