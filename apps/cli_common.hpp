@@ -47,5 +47,6 @@ void add_sweep_command(CLI::App& app, int& exit_code);
 void add_benchmark_command(CLI::App& app, int& exit_code);
 void add_scaling_command(CLI::App& app, int& exit_code);
 void add_batch_command(CLI::App& app, int& exit_code);
+void add_motion_check_command(CLI::App& app, int& exit_code);  // roiflow motion-check
 
 }  // namespace roiflow::cli

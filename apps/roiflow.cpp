@@ -58,6 +58,7 @@ int main(int argc, char** argv) {
   add_scaling_command(app, exit_code);
   add_benchmark_command(app, exit_code);
   add_batch_command(app, exit_code);
+  add_motion_check_command(app, exit_code);
 
   try {
     app.parse(argc, argv);

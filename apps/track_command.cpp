@@ -1,5 +1,6 @@
-// roiflow track: one object through a video (pipeline::run_track_video); --compare runs it in
-// local and in global mode (pipeline::run_compare).
+// roiflow track: every moving object of a fixed-camera video, or the --init targets
+// (pipeline::track_objects_video); one object with --single or one --init
+// (pipeline::run_track_video); --compare runs that in local and in global mode.
 #include <csignal>
 #include <filesystem>
 #include <iostream>
@@ -8,6 +9,7 @@
 #include "core/atomic_write.hpp"
 #include "eval/otb_score.hpp"
 #include "pipeline/compare.hpp"
+#include "pipeline/mot_run.hpp"
 #include "pipeline/run_json.hpp"
 #include "stages/track_log_sink.hpp"
 
@@ -19,7 +21,9 @@ namespace fs = std::filesystem;
 struct TrackCommand {
   LkOptions lk;
   std::string input;
-  std::string init;
+  std::vector<std::string> inits;  // every --init
+  std::string init_file, mot;      // --init-file, --mot
+  bool single = false;             // --single: one object even without --init
   std::string mode = "local";
   std::string summary;
   pipeline::TrackRunOptions run;  // --roi, --lk-patches, --log, --out, --in-flight, ...
@@ -34,7 +38,7 @@ pipeline::TrackRunOptions run_options(const TrackCommand& cmd) {
   params.lk = lk_params(cmd.lk);
   params.mode = stages::track_mode_from_string(cmd.mode);
   try {
-    if (!cmd.init.empty()) params.init = eval::parse_box(cmd.init);
+    if (!cmd.inits.empty()) params.init = eval::parse_box(cmd.inits.front());
   } catch (const Error& e) {
     throw UsageError(std::string("--init: ") + e.what());
   }
@@ -69,7 +73,57 @@ int run_compare(const TrackCommand& cmd) {
   return 0;
 }
 
+int finish(const std::string& summary, nlohmann::ordered_json& doc, const std::string& text,
+           std::vector<std::string> written, const pipeline::Ending& end) {
+  if (!summary.empty()) {
+    write_text_atomically(summary, doc.dump(2) + "\n");
+    written.push_back(summary);
+  }
+  std::cout << text;
+  if (!written.empty()) std::cout << "  wrote " << joined(written) << "\n";
+  if (end.exit_code != 0) std::cerr << "roiflow: error: " << end.message << "\n";
+  return end.exit_code;
+}
+
+int run_objects(const TrackCommand& cmd) {
+  pipeline::MotRunOptions o;
+  o.params.known = pipeline::known_targets(cmd.inits, cmd.init_file);
+  o.params.births = o.params.known.empty();
+  o.params.lk = lk_params(cmd.lk);
+  try {
+    o.params.validate();
+  } catch (const Error& e) {
+    throw UsageError(e.what());
+  }
+  o.log = cmd.run.log, o.mot = cmd.mot, o.video = cmd.run.video;
+  if (!o.log.empty()) stages::check_track_log_path(o.log, "--log");
+  for (const auto& [path, name] :
+       {std::pair{o.mot, "--mot"}, {o.video, "--out"}, {cmd.summary, "--summary"}})
+    if (!path.empty()) check_output_path(path, name);
+  o.threads = cmd.lk.threads, o.in_flight = cmd.run.max_in_flight, o.progress = cmd.run.progress;
+  o.cancel = pipeline::cancel_flag();
+  stages::VideoSource source(cmd.input, pipeline::source_params(cmd.source));
+  pipeline::SignalScope signals;
+  pipeline::MotRun r = pipeline::track_objects_video(source, o);
+  std::vector<std::string> written;
+  for (const std::string* path : {&o.log, &o.mot, &o.video})
+    if (!path->empty()) written.push_back(*path);
+  return finish(cmd.summary, r.summary,
+                pipeline::objects_summary_text("track " + source.description(), r.summary), written,
+                pipeline::ending(r.end, r.report.frames, source.status().message));
+}
+
 int run_track(const TrackCommand& cmd) {
+  const bool several = cmd.inits.size() > 1 || !cmd.init_file.empty();
+  if (!cmd.compare && !cmd.single && cmd.mode == "local" && (several || cmd.inits.empty()))
+    return run_objects(cmd);
+  if (several)
+    throw UsageError(
+        "several targets (--init twice, --init-file) need --mode local without --single or "
+        "--compare");
+  if (!cmd.mot.empty())
+    throw UsageError(
+        "--mot needs the multi-object tracker (not --single, --mode global or --compare)");
   if (cmd.compare) return run_compare(cmd);
   const pipeline::TrackRunOptions run = run_options(cmd);
   if (!run.log.empty()) stages::check_track_log_path(run.log, "--log");
@@ -87,14 +141,7 @@ int run_track(const TrackCommand& cmd) {
   std::vector<std::string> written;
   if (!run.log.empty()) written.push_back(run.log);
   if (!run.video.empty()) written.push_back(run.video);
-  if (!cmd.summary.empty()) {
-    write_text_atomically(cmd.summary, doc.dump(2) + "\n");
-    written.push_back(cmd.summary);
-  }
-  std::cout << pipeline::summary_text("track " + s.input, s);
-  if (!written.empty()) std::cout << "  wrote " << joined(written) << "\n";
-  if (end.exit_code != 0) std::cerr << "roiflow: error: " << end.message << "\n";
-  return end.exit_code;
+  return finish(cmd.summary, doc, pipeline::summary_text("track " + s.input, s), written, end);
 }
 
 }  // namespace
@@ -102,15 +149,21 @@ int run_track(const TrackCommand& cmd) {
 void add_track_command(CLI::App& app, int& exit_code) {
   static TrackCommand cmd;
   CLI::App* sub = app.add_subcommand(
-      "track", "Track the moving object of a video with LK in a local region (paper's system)");
+      "track", "Track every moving object of a video (or one) with LK in local regions");
   sub->add_option("INPUT", cmd.input,
                   "video file, image-sequence folder (OTB img/), camera index, or "
                   "synthetic:N[:WxH] (a generated stream of N frames, for soak runs)")
       ->required();
-  sub->add_option("--init", cmd.init,
-                  "the target's box in the first frame, x,y,w,h (OTB protocol); without it the "
-                  "global treatment finds the moving object")
-      ->type_name("X,Y,W,H");
+  sub->add_option("--init", cmd.inits,
+                  "a target's box in the first frame, x,y,w,h (OTB protocol); once: the "
+                  "single-object tracker; repeated: those targets (ids 1, 2, ...); without it "
+                  "every moving object is found and followed (fixed camera)")
+      ->type_name("X,Y,W,H")
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  sub->add_option("--init-file", cmd.init_file, "known targets, one id,x,y,w,h line each")
+      ->type_name("FILE");
+  sub->add_option("--mot", cmd.mot, "every object's boxes, MOTChallenge format")->type_name("FILE");
+  sub->add_flag("--single", cmd.single, "follow one object (the paper's tracker) without --init");
   sub->add_option("--roi", cmd.run.tracker.roi, "side of the local region in pixels")
       ->check(CLI::Range(8, 4096))
       ->capture_default_str();

@@ -24,7 +24,7 @@ trap 'rm -rf "$work"' EXIT
 export GST_PLUGIN_PATH=$build/gstreamer GST_REGISTRY=$work/registry.bin
 
 # --- GStreamer element vs roiflow track
-"$bin" track "$video" --no-progress --log "$work/cli.csv" >/dev/null || gate_fail "roiflow track failed"
+"$bin" track "$video" --single --no-progress --log "$work/cli.csv" >/dev/null || gate_fail "roiflow track failed"
 "$launch" -q filesrc location="$video" ! decodebin ! videoconvert \
   ! roiflowtrack log="$work/gst.csv" ! fakesink >/dev/null 2>"$work/gst.err" ||
   gate_fail "gst-launch-1.0 pipeline failed: $(tail -n 1 "$work/gst.err")"

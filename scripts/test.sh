@@ -37,3 +37,5 @@ else
   echo "test: WARNING: no GStreamer plugin built: the drop-in gate did NOT run" >&2
 fi
 scripts/benchmark_gate.sh "$data/tracking"
+scripts/mot_gate.sh "$data"
+scripts/mot_demo_gate.sh  # synthetic traffic, no data needed; runs with the other gates

@@ -64,16 +64,25 @@ float parse_float(std::string_view field, const char* name, const LineError& err
   return static_cast<float>(value);
 }
 
-TrackRecord parse_row(std::string_view line, const LineError& error) {
-  const std::vector<std::string_view> f = split_commas(line);
-  if (f.size() != 10) {
-    error.fail("expected 10 fields (" + std::string(kTrackCsvHeader) + "), got " +
+TrackRecord parse_row(std::string_view line, bool with_id, const LineError& error) {
+  std::vector<std::string_view> f = split_commas(line);
+  const std::size_t expected = with_id ? 11 : 10;
+  if (f.size() != expected) {
+    error.fail("expected " + std::to_string(expected) + " fields (" +
+               std::string(with_id ? kTrackCsvHeader : kTrackCsvHeaderV1) + "), got " +
                std::to_string(f.size()));
   }
   TrackRecord r;
   const auto [end, ec] = std::from_chars(f[0].data(), f[0].data() + f[0].size(), r.frame);
   if (ec != std::errc() || end != f[0].data() + f[0].size() || r.frame < 1) {
     error.fail("frame " + quoted_excerpt(f[0]) + " is not a frame number (1, 2, ...)");
+  }
+  if (with_id) {
+    const auto [id_end, id_ec] = std::from_chars(f[1].data(), f[1].data() + f[1].size(), r.id);
+    if (id_ec != std::errc() || id_end != f[1].data() + f[1].size() || r.id < 1) {
+      error.fail("id " + quoted_excerpt(f[1]) + " is not an object id (1, 2, ...)");
+    }
+    f.erase(f.begin() + 1);
   }
   r.box.x = parse_float(f[1], "x", error);
   r.box.y = parse_float(f[2], "y", error);
@@ -107,6 +116,7 @@ const char* to_string(TrackRecord::Mode mode) {
 void check_track_record(const TrackRecord& r, const std::string& path) {
   const std::string where = "track log '" + path + "', frame " + std::to_string(r.frame) + ": ";
   if (r.frame < 1) throw Error(where + "frames are numbered from 1");
+  if (r.id < 1) throw Error(where + "object ids are numbered from 1");
   const double values[] = {r.box.x,      r.box.y,      r.box.width, r.box.height,
                            r.velocity.x, r.velocity.y, r.ms};
   const char* names[] = {"x", "y", "w", "h", "vx", "vy", "ms"};
@@ -122,15 +132,17 @@ void check_track_record(const TrackRecord& r, const std::string& path) {
 }
 
 std::string track_csv_row(const TrackRecord& r) {
-  return std::to_string(r.frame) + "," + log_fixed(r.box.x, kBoxDecimals) + "," +
-         log_fixed(r.box.y, kBoxDecimals) + "," + log_fixed(r.box.width, kBoxDecimals) + "," +
-         log_fixed(r.box.height, kBoxDecimals) + "," + log_fixed(r.velocity.x, kVelocityDecimals) +
-         "," + log_fixed(r.velocity.y, kVelocityDecimals) + "," + to_string(r.mode) + "," +
+  return std::to_string(r.frame) + "," + std::to_string(r.id) + "," +
+         log_fixed(r.box.x, kBoxDecimals) + "," + log_fixed(r.box.y, kBoxDecimals) + "," +
+         log_fixed(r.box.width, kBoxDecimals) + "," + log_fixed(r.box.height, kBoxDecimals) + "," +
+         log_fixed(r.velocity.x, kVelocityDecimals) + "," +
+         log_fixed(r.velocity.y, kVelocityDecimals) + "," + to_string(r.mode) + "," +
          (r.lost ? "1" : "0") + "," + log_fixed(r.ms, kMsDecimals) + "\n";
 }
 
 std::string track_json_object(const TrackRecord& r) {
   const nlohmann::ordered_json object = {{"frame", r.frame},
+                                         {"id", r.id},
                                          {"x", rounded(r.box.x, kBoxDecimals)},
                                          {"y", rounded(r.box.y, kBoxDecimals)},
                                          {"w", rounded(r.box.width, kBoxDecimals)},
@@ -145,16 +157,18 @@ std::string track_json_object(const TrackRecord& r) {
 
 std::vector<TrackRecord> parse_track_csv(std::string_view text, const std::string& name) {
   std::vector<TrackRecord> records;
+  bool with_id = true;
   const long long lines = for_each_line(text, [&](long long number, std::string_view line) {
     const LineError error(name, number);
     if (number == 1) {
-      if (line != kTrackCsvHeader) {
+      if (line != kTrackCsvHeader && line != kTrackCsvHeaderV1) {
         error.fail("header " + quoted_excerpt(line) + " is not '" + std::string(kTrackCsvHeader) +
-                   "'");
+                   "' (or, before the id column, '" + std::string(kTrackCsvHeaderV1) + "')");
       }
+      with_id = line == kTrackCsvHeader;
       return;
     }
-    records.push_back(parse_row(line, error));
+    records.push_back(parse_row(line, with_id, error));
   });
   if (lines == 0)
     LineError(name, 1).fail("empty file, expected '" + std::string(kTrackCsvHeader) + "'");

@@ -1,10 +1,13 @@
-// The track-log format: one record per frame of a tracking run, as CSV (the header
-// `frame,x,y,w,h,vx,vy,mode,lost,ms`, box to 2 decimals, velocity and ms to 3) or as a JSON array
-// of objects with the same keys and rounding, one per line; and the strict CSV reader. The
-// writer that keeps a file valid while a run goes is stages::TrackLogWriter.
+// The track-log format: one record per object and frame of a tracking run, as CSV or JSON, and
+// its strict CSV reader. CSV: the header `frame,id,x,y,w,h,vx,vy,mode,lost,ms`, then one line per
+// record with the object's id, the box to 2 decimals, the velocity and ms to 3, mode `local` or
+// `global`, lost `0` or `1`. The reader also takes the logs written before the id column
+// (`frame,x,y,w,h,vx,vy,mode,lost,ms`: every record gets id 1). JSON: an array of objects with the
+// same keys and rounding, one per line. The writer that keeps a file valid while a run goes is
+// stages::TrackLogWriter.
 //
 //   roiflow::eval::TrackRecord r;
-//   r.box = {70, 51, 107, 87};  // frame 1
+//   r.box = {70, 51, 107, 87};  // frame 1, id 1
 //   const std::string csv =
 //       std::string(roiflow::eval::kTrackCsvHeader) + "\n" + roiflow::eval::track_csv_row(r);
 //   const auto records = roiflow::eval::parse_track_csv(csv, "memory");  // r, rounded
@@ -25,10 +28,13 @@ struct TrackRecord {
   cv::Point2f velocity;     // pixels per frame
   Mode mode = Mode::Local;  // which treatment produced the box
   bool lost = false;
-  double ms = 0;  // tracker time spent on this frame, milliseconds
+  double ms = 0;     // tracker time spent on this frame, milliseconds
+  long long id = 1;  // the object's id (>= 1); single-object runs use 1
 };
 
-inline constexpr std::string_view kTrackCsvHeader = "frame,x,y,w,h,vx,vy,mode,lost,ms";
+inline constexpr std::string_view kTrackCsvHeader = "frame,id,x,y,w,h,vx,vy,mode,lost,ms";
+// The header of logs written before the id column; still read.
+inline constexpr std::string_view kTrackCsvHeaderV1 = "frame,x,y,w,h,vx,vy,mode,lost,ms";
 
 const char* to_string(TrackRecord::Mode mode);  // "local" | "global"
 
@@ -41,9 +47,10 @@ std::string track_csv_row(const TrackRecord& record);
 std::string track_json_object(const TrackRecord& record);
 
 // Reads a track-log CSV. Strict, because scores are computed from it: the header must match
-// exactly, every row holds 10 fields, numbers parse completely and are finite (box and velocity
-// within the float range), mode is local|global and lost 0|1. Windows line ends are accepted.
-// Anything else throws roiflow::Error as `path:line: what was wrong`.
+// exactly (either header), every row holds its 11 (10 without id) fields, numbers parse completely
+// and are finite (box and velocity within the float range), mode is local|global and lost 0|1.
+// Windows line ends are accepted. Anything else throws roiflow::Error as `path:line: what was
+// wrong`.
 std::vector<TrackRecord> read_track_csv(const std::string& path);
 // The same from a file's text held in memory; `name` stands for the path in error messages.
 std::vector<TrackRecord> parse_track_csv(std::string_view text, const std::string& name);

@@ -493,4 +493,196 @@ RunReport run_dense(const FrameSource& source, const flow::LkParams& params,
   });
 }
 
+RunReport run_mot(const FrameSource& source, const stages::MultiTrackerParams& params,
+                  const std::vector<MotSink>& sinks, const GraphOptions& options) {
+  params.validate();
+  return run_in_arena(options, [&](int limit, Clock::time_point start) {
+    Run run(options);
+    tf::graph g;
+    FrontEnd front(g, run, source, limit, params.lk.levels, params.lk.sigma);
+
+    // A frame after the background refresh and the global treatment.
+    struct SeenMsg {
+      long long seq = 0;
+      FrameMsg frame;
+      std::shared_ptr<const stages::Foreground> fg;
+      std::shared_ptr<const std::vector<stages::Detection>> detections;
+    };
+    // The decisions at frame t, with what the plan of t+1 needs of frame t.
+    struct DecidedMsg {
+      long long seq = -1;
+      std::shared_ptr<const stages::TrackSet> state;
+      std::shared_ptr<const flow::Pyramid> pyramid;
+      std::shared_ptr<const stages::Foreground> fg;
+    };
+    // One frame's work between plan and decision.
+    struct FrameWork {
+      SeenMsg now;
+      DecidedMsg before;
+      std::vector<stages::ObjectTile> tiles;
+      Clock::time_point planned;
+    };
+    struct TileMsg {
+      std::shared_ptr<const FrameWork> work;
+      std::size_t tile = 0;
+    };
+    // To the collector: a tile's motion, or (tile < 0) a frame without tiles.
+    struct CollectMsg {
+      std::shared_ptr<const FrameWork> work;
+      long long tile = -1;
+      stages::TileMotion motion;
+    };
+    struct CollectedMsg {
+      std::shared_ptr<const FrameWork> work;
+      std::vector<stages::TileMotion> motions;
+    };
+
+    // Background refresh: serial, in frame order (the model learns the frames in order).
+    stages::MotionDetector detector(params.detector);
+    tf::function_node<FrameMsg, SeenMsg> background(g, tf::serial, [&](const FrameMsg& m) {
+      run.enter(Stage::Track, m.seq);
+      const auto t0 = Clock::now();
+      SeenMsg out;
+      out.seq = m.seq;
+      out.frame = m;
+      out.fg = std::make_shared<const stages::Foreground>(detector.observe(m.frame->picture()));
+      run.time("background", t0);
+      return out;
+    });
+    // Global treatment: the moving objects of each frame, several frames at once.
+    tf::function_node<SeenMsg, SeenMsg> global(g, tf::unlimited, [&](SeenMsg m) {
+      const auto t0 = Clock::now();
+      m.detections = std::make_shared<const std::vector<stages::Detection>>(
+          stages::detect_objects(*m.fg, params.detector));
+      run.time("global", t0);
+      return m;
+    });
+    tf::sequencer_node<SeenMsg> seen_order(
+        g, [](const SeenMsg& m) { return static_cast<std::size_t>(m.seq); });
+    // Frame t+1 meets the decisions at t: the feedback edge.
+    tf::join_node<std::tuple<SeenMsg, DecidedMsg>, tf::queueing> meet(g);
+
+    using PlanNode =
+        tf::multifunction_node<std::tuple<SeenMsg, DecidedMsg>, std::tuple<TileMsg, CollectMsg>>;
+    PlanNode plan(g, tf::serial, [&](const std::tuple<SeenMsg, DecidedMsg>& in, auto& ports) {
+      const SeenMsg& now = std::get<0>(in);
+      run.enter(Stage::Track, now.seq);
+      const auto t0 = Clock::now();
+      auto work = std::make_shared<FrameWork>();
+      work->now = now;
+      work->before = std::get<1>(in);
+      work->planned = t0;
+      if (work->before.pyramid) {
+        work->tiles = stages::plan_tiles(*work->before.state, *work->before.fg, params);
+      }
+      std::shared_ptr<const FrameWork> shared = work;
+      run.time("plan", t0);
+      // A frame without tiles goes to the collector as a header (it completes at once).
+      if (shared->tiles.empty()) std::get<1>(ports).try_put(CollectMsg{shared, -1, {}});
+      for (std::size_t i = 0; i < shared->tiles.size(); ++i)
+        std::get<0>(ports).try_put(TileMsg{shared, i});
+    });
+
+    // LK refinement over ROI tiles: one task per tile, a frame's tiles at once. Each task
+    // borrows a DenseLK (its workspace stays warm) from a free list.
+    std::mutex lk_mutex;
+    std::vector<std::unique_ptr<flow::DenseLK>> lk_free;
+    tf::function_node<TileMsg, CollectMsg> lk_tiles(g, tf::unlimited, [&](const TileMsg& m) {
+      run.enter(Stage::Flow, m.work->now.seq);
+      const auto t0 = Clock::now();
+      std::unique_ptr<flow::DenseLK> lk;
+      {
+        const std::lock_guard<std::mutex> lock(lk_mutex);
+        if (!lk_free.empty()) {
+          lk = std::move(lk_free.back());
+          lk_free.pop_back();
+        }
+      }
+      if (!lk) lk = std::make_unique<flow::DenseLK>(params.lk);
+      CollectMsg out{m.work, static_cast<long long>(m.tile), {}};
+      out.motion =
+          stages::measure_tile(m.work->tiles[m.tile], *m.work->before.pyramid,
+                               *m.work->now.frame.pyramid, *m.work->before.fg, *lk, params);
+      {
+        const std::lock_guard<std::mutex> lock(lk_mutex);
+        lk_free.push_back(std::move(lk));
+      }
+      run.time("lk", t0);
+      return out;
+    });
+
+    // Joins a frame's tiles (they finish in any order) before its decision.
+    struct Pending {
+      std::shared_ptr<const FrameWork> work;
+      std::vector<stages::TileMotion> motions;
+    };
+    std::unordered_map<const FrameWork*, Pending> pending;  // the serial collector's only
+    using CollectNode = tf::multifunction_node<CollectMsg, std::tuple<CollectedMsg>>;
+    CollectNode collect(g, tf::serial, [&](const CollectMsg& m, auto& ports) {
+      Pending& p = pending[m.work.get()];
+      p.work = m.work;
+      if (m.tile >= 0) p.motions.push_back(m.motion);
+      if (p.motions.size() == m.work->tiles.size()) {
+        std::get<0>(ports).try_put(CollectedMsg{m.work, std::move(p.motions)});
+        pending.erase(m.work.get());
+      }
+    });
+
+    using DecideNode =
+        tf::multifunction_node<CollectedMsg, std::tuple<DecidedMsg, MotTrackedFrame>>;
+    DecideNode decision(g, tf::serial, [&](const CollectedMsg& m, auto& ports) {
+      const SeenMsg& now = m.work->now;
+      run.enter(Stage::Track, now.seq);
+      const auto t0 = Clock::now();
+      bool global_frame = false;
+      auto state = std::make_shared<const stages::TrackSet>(stages::decide(
+          *m.work->before.state, now.frame.frame->index, now.frame.frame->gray.size(), m.motions,
+          *now.fg, *now.detections, params, &global_frame));
+      auto out =
+          std::make_shared<stages::MotFrame>(stages::report_frame(*state, m.motions, global_frame));
+      for (stages::TrackedObject& o : out->objects) {
+        for (const stages::TileMotion& tm : m.motions) {
+          const std::size_t ti = tm.track;
+          if (ti < m.work->before.state->tracks.size() &&
+              m.work->before.state->tracks[ti].id == o.id)
+            o.region |= tm.region;
+        }
+      }
+      run.time("decide", t0);
+      out->ms = ms_since(m.work->planned);
+      std::get<0>(ports).try_put(DecidedMsg{now.seq, state, now.frame.pyramid, now.fg});
+      std::get<1>(ports).try_put(MotTrackedFrame{now.seq, now.frame.frame, std::move(out)});
+    });
+
+    tf::sequencer_node<MotTrackedFrame> out_order(
+        g, [](const MotTrackedFrame& f) { return static_cast<std::size_t>(f.seq); });
+    tf::broadcast_node<MotTrackedFrame> to_sinks(g);
+    auto sink_nodes = make_sink_nodes<MotTrackedFrame>(g, run, sinks, 0);
+    RetireNode retire = make_retire_node(g, run, static_cast<int>(sink_nodes.size()));
+
+    tf::make_edge(front.output(), background);
+    tf::make_edge(background, global);
+    tf::make_edge(global, seen_order);
+    tf::make_edge(seen_order, tf::input_port<0>(meet));
+    tf::make_edge(meet, plan);
+    tf::make_edge(tf::output_port<0>(plan), lk_tiles);
+    tf::make_edge(tf::output_port<1>(plan), collect);
+    tf::make_edge(lk_tiles, collect);
+    tf::make_edge(tf::output_port<0>(collect), decision);
+    tf::make_edge(tf::output_port<0>(decision), tf::input_port<1>(meet));
+    tf::make_edge(tf::output_port<1>(decision), out_order);
+    tf::make_edge(out_order, to_sinks);
+    for (auto& node : sink_nodes) {
+      tf::make_edge(to_sinks, node);
+      tf::make_edge(node, retire);
+    }
+    tf::make_edge(tf::output_port<0>(retire), front.retire_port());
+
+    DecidedMsg seed;
+    seed.state = std::make_shared<const stages::TrackSet>(stages::initial_tracks(params));
+    tf::input_port<1>(meet).try_put(seed);
+    return finish(g, run, front, start);
+  });
+}
+
 }  // namespace roiflow::pipeline

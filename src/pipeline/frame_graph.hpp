@@ -30,6 +30,7 @@
 #include "flow/dense_lk.hpp"
 #include "flow/pyramid.hpp"
 #include "report/run_stats.hpp"
+#include "stages/multi_tracker.hpp"
 #include "stages/tracker.hpp"
 #include "stages/video_source.hpp"
 
@@ -115,6 +116,39 @@ struct FlowSink {
 
 RunReport run_dense(const FrameSource& source, const flow::LkParams& params,
                     const std::vector<FlowSink>& sinks, const GraphOptions& options = {});
+
+// ------------------------------------------------------------------- multi-object tracking mode
+//
+// Every moving object of a fixed camera (stages/multi_tracker.hpp), on this graph:
+//
+//   front end ─► background (serial: MOG2 refresh) ─► global (detect_objects) ─► sequencer ─┐
+//                                                                                           ▼
+//          ┌──────────────── decisions at t (feedback edge) ─────────────────────► join (t+1, t)
+//          │                                                                                │
+//   decision (serial) ◄─ collect (serial, per frame) ◄─ LK tiles (parallel) ◄─ plan (serial)◄┘
+//          │
+//          └─► sequencer ─► sinks ─► retire ─► limiter
+//
+// The plan node pairs frame t+1 with the decisions at t (a queueing join: the decisions come
+// back on an edge, nothing is kept in a node) and puts one task per tile of every object's
+// region; the tiles of a frame run at once and a serial node joins them per frame before the
+// decision. The background refresh and the global treatment of later frames run beside the
+// LK tiles and decisions of earlier ones (pipelined), bounded by the limiter.
+
+struct MotTrackedFrame {
+  long long seq = 0;
+  std::shared_ptr<const stages::Frame> frame;
+  std::shared_ptr<const stages::MotFrame> output;
+};
+
+struct MotSink {
+  std::string name;
+  std::function<void(const MotTrackedFrame&)> consume;
+};
+
+// Stage times in options.stats: "pyramid", "background", "global", "plan", "lk", "decide".
+RunReport run_mot(const FrameSource& source, const stages::MultiTrackerParams& params,
+                  const std::vector<MotSink>& sinks, const GraphOptions& options = {});
 
 const char* to_string(Stage stage);
 

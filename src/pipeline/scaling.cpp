@@ -9,6 +9,7 @@
 
 #include "core/error.hpp"
 #include "pipeline/frame_graph.hpp"
+#include "pipeline/mot_run.hpp"
 #include "pipeline/tbb_executor.hpp"
 #include "report/run_stats.hpp"
 #include "stages/tracker.hpp"
@@ -60,6 +61,16 @@ Measured run_once(const ScalingOptions& o, int threads) {
     const nlohmann::ordered_json s = stats.to_json(report.wall_s);
     m.tracker_ms = stage_ms(s, "flow");
     m.frames = std::max<long long>(0, report.frames - 1);  // pairs
+  } else if (o.mode == ScalingMode::Local) {
+    MotRunOptions mot;
+    mot.params.lk = o.lk;
+    mot.threads = threads;
+    mot.cancel = o.cancel;
+    const MotRun run = track_objects(frames, source.size(), source.fps(), mot);
+    report = run.report;
+    m.tracker_ms =
+        run.summary.at("tracker_ms_per_frame").get<double>() * static_cast<double>(report.frames);
+    m.frames = report.frames;
   } else {
     stages::TrackerParams params;
     params.lk = o.lk;

@@ -15,12 +15,14 @@
 // of that many slots (pipeline::GraphOptions::threads) under a tbb::global_control that caps
 // oneTBB's parallelism at that count, and no sink (no file is written, nothing but the work is
 // timed). The work per mode:
-//  - Local: fixed-camera tracking (stages::Tracker, local mode): every frame through the graph
-//    (decode, pyramids while wanted, the tracker's local treatment).
-//  - Global: the same with the global treatment on every frame.
+//  - Local: fixed-camera tracking of every moving object (pipeline::track_objects, as
+//    `roiflow track` without --init): motion detection, per-object LK tiles, decisions.
+//  - Global: the single-object tracker (stages::Tracker) with the global treatment on every
+//    frame.
 //  - Dense: dense LK between every pair of frames (run_dense).
 // fps is frames (dense: pairs) per second of wall time; tracker_fps counts only the time inside
-// the tracker's stages (tracking: pyramid + track; dense: flow), summed over the frames.
+// the tracker's stages (local: the multi-object graph's pyramid, background, global, plan,
+// lk and decide; global: pyramid + track; dense: flow), summed over the frames.
 // speedup = fps / fps of the first row (the smallest thread count, normally 1); efficiency =
 // speedup x (first row's threads / threads). With `repeats` > 1 each count keeps its fastest run
 // (least wall time): on a shared machine the fastest run is the one least disturbed.

@@ -171,4 +171,64 @@ cv::Mat annotate_frame(const cv::Mat& image, const TrackAnnotation& out,
   return canvas;
 }
 
+cv::Scalar id_color(long long id) {
+  // Hues spread by the golden angle: neighbouring ids far apart on the colour wheel.
+  const double hue = std::fmod(static_cast<double>(id < 0 ? -id : id) * 137.508, 360.0);
+  cv::Mat hsv(1, 1, CV_8UC3, cv::Scalar(hue / 2.0, 230, 255)), bgr;
+  cv::cvtColor(hsv, bgr, cv::COLOR_HSV2BGR);
+  const cv::Vec3b c = bgr.at<cv::Vec3b>(0, 0);
+  return {static_cast<double>(c[0]), static_cast<double>(c[1]), static_cast<double>(c[2])};
+}
+
+cv::Mat annotate_objects(const cv::Mat& image, const ObjectsAnnotation& frame,
+                         const AnnotateStyle& style) {
+  check_style(style);
+  cv::Mat canvas = bgr_copy(image);
+  const int margin = style.thickness + 2;
+  const int font = cv::FONT_HERSHEY_SIMPLEX;
+  const double scale = std::max(0.4, canvas.rows / 1200.0);
+  for (const ObjectAnnotation& o : frame.objects) {
+    const cv::Scalar color = id_color(o.id);
+    if (auto region = drawable(cv::Rect2f(o.region), canvas.size(), margin);
+        region && !o.region.empty()) {
+      cv::rectangle(canvas, *region, color * 0.6, 1, cv::LINE_8);
+    }
+    const auto box = drawable(o.box, canvas.size(), margin);
+    if (!box) continue;
+    draw_box(canvas, *box, color, style.thickness, o.lost);
+    TrackAnnotation arrow;
+    arrow.box = o.box;
+    arrow.velocity = o.velocity;
+    AnnotateStyle arrow_style = style;
+    arrow_style.arrow_color = color;
+    draw_velocity(canvas, arrow, arrow_style);
+    std::string label = "#";  // appended, not "#" + ...: GCC 12 warns falsely (-Wrestrict)
+    label += std::to_string(o.id);
+    int baseline = 0;
+    const cv::Size size = cv::getTextSize(label, font, scale, 1, &baseline);
+    const cv::Point at(std::clamp(box->x, 0, std::max(0, canvas.cols - size.width)),
+                       std::clamp(box->y - 3, size.height, std::max(size.height, canvas.rows - 1)));
+    cv::rectangle(canvas, cv::Rect(at.x, at.y - size.height - 1, size.width, size.height + 3),
+                  cv::Scalar(0, 0, 0), cv::FILLED);
+    cv::putText(canvas, label, at, font, scale, color, 1, cv::LINE_AA);
+  }
+  if (style.text) {
+    long long shown = 0;
+    for (const ObjectAnnotation& o : frame.objects)
+      if (!o.lost) ++shown;
+    std::string text = "frame " + std::to_string(frame.index + 1) + "  objects " +
+                       std::to_string(shown) + "  born " + std::to_string(frame.born) + "  ended " +
+                       std::to_string(frame.ended) + (frame.global ? "  global" : "");
+    const double tscale = std::max(0.4, canvas.rows / 960.0);
+    int baseline = 0;
+    const cv::Size size = cv::getTextSize(text, font, tscale, 1, &baseline);
+    const int pad = 4;
+    cv::rectangle(canvas, cv::Rect(0, 0, size.width + 2 * pad, size.height + baseline + 2 * pad),
+                  cv::Scalar(0, 0, 0), cv::FILLED);
+    cv::putText(canvas, text, cv::Point(pad, pad + size.height), font, tscale,
+                cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  }
+  return canvas;
+}
+
 }  // namespace roiflow::report

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <opencv2/core.hpp>
+#include <vector>
 
 namespace roiflow::report {
 
@@ -43,5 +44,34 @@ struct AnnotateStyle {
 
 cv::Mat annotate_frame(const cv::Mat& image, const TrackAnnotation& out,
                        const AnnotateStyle& style = {});
+
+// Every object of a multi-object frame (stages::MotFrame, filled by the pipeline):
+//
+//   roiflow::report::ObjectsAnnotation a;
+//   a.objects.push_back({3, {70, 51, 30, 80}, {2.f, 0.f}, false, {}});
+//   cv::Mat bgr = roiflow::report::annotate_objects(cv::Mat(240, 320, CV_8UC1, 128), a);
+//
+// Each id gets its own colour (id_color): its box (solid; dashed while lost), its label "#id"
+// above the box, its LK region's outline (thin) and its velocity arrow from the box centre
+// (`arrow_scale` times one frame's motion). A text line in the top-left corner says
+// "frame N  objects K  born B  ended E", plus "  global" on the frames the global treatment
+// looked for new objects.
+struct ObjectAnnotation {
+  long long id = 0;
+  cv::Rect2f box;
+  cv::Point2f velocity;
+  bool lost = false;
+  cv::Rect region;  // where LK ran, may be empty
+};
+struct ObjectsAnnotation {
+  long long index = 0;  // 0-based (shown 1-based)
+  std::vector<ObjectAnnotation> objects;
+  long long born = 0, ended = 0;
+  bool global = false;
+};
+// A bright BGR colour per id, different for neighbouring ids.
+cv::Scalar id_color(long long id);
+cv::Mat annotate_objects(const cv::Mat& image, const ObjectsAnnotation& frame,
+                         const AnnotateStyle& style = {});
 
 }  // namespace roiflow::report

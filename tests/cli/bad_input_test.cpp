@@ -343,7 +343,7 @@ TEST_F(BadInputTest, SequenceWithUnreadableFrame) {
   const std::string jpg = read_text(path("jpg/5.jpg"));
   write_bytes("jpg/5.jpg", jpg.substr(0, jpg.size() * 2 / 3));
   expect_error(
-      {"track", path("jpg"), "--log", path("jpg.csv"), "--no-progress"}, 1,
+      {"track", path("jpg"), "--single", "--log", path("jpg.csv"), "--no-progress"}, 1,
       "stopped at frame 4: cannot decode image '" + path("jpg/5.jpg") + "': truncated JPEG");
   EXPECT_EQ(eval::read_track_csv(path("jpg.csv")).size(), 4u);
   // The first frame unreadable: nothing to start from.

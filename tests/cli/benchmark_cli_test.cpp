@@ -68,7 +68,7 @@ TEST_F(BenchmarkCliTest, TracksWritesALogPerRunThatScoreReads) {
     const std::string log = path(std::string("out/tracks/beta/") + tracker + ".csv");
     const std::vector<std::string> lines = lines_of(read_text(log));
     ASSERT_EQ(lines.size(), 11u);
-    EXPECT_EQ(lines[0], "frame,x,y,w,h,vx,vy,mode,lost,ms");
+    EXPECT_EQ(lines[0], "frame,id,x,y,w,h,vx,vy,mode,lost,ms");
     const CliResult s =
         run({"score", log, path("set/beta/groundtruth_rect.txt"), "--format", "json"});
     EXPECT_EQ(s.exit_code, 0) << s.err;

@@ -138,6 +138,118 @@ TEST(MotScore, IdF1PairsIdsGlobally) {
   EXPECT_DOUBLE_EQ(s.idp, 0.5);
 }
 
+// The single- and two-object cases of py-motmetrics' own test suite (tests/test_metrics.py,
+// test_kscore_* and test_correct_average), with their expected MOTA, IDF1 and switches. Each
+// frame lists its objects and, per hypothesis, the object it overlaps (0: none). An object
+// sits at x = 100 * id; a hypothesis is put on its object's box, or far from everything.
+struct Frame {
+  std::vector<int> objects;
+  std::vector<std::pair<int, int>> hyps;  // (hypothesis id, object it overlaps or 0)
+};
+MotScore score_frames(const std::vector<Frame>& frames) {
+  std::vector<MotBox> gt, pred;
+  for (std::size_t f = 0; f < frames.size(); ++f) {
+    const int frame = static_cast<int>(f) + 1;
+    for (int o : frames[f].objects)
+      gt.push_back(box(frame, o, 100.0 * o));
+    for (const auto& [h, o] : frames[f].hyps)
+      pred.push_back(box(frame, h, o > 0 ? 100.0 * o : 5000.0 + 100 * h));
+  }
+  return score(pred, gt);
+}
+
+TEST(MotScore, AgreesWithPyMotmetricsOwnCases) {
+  struct Case {
+    const char* name;
+    std::vector<Frame> frames;
+    double mota, idf1;
+    long long switches;
+  };
+  const int a = 1, b = 2, c = 3, d = 4;
+  std::vector<Case> cases;
+  {  // kscore_1: hypothesis b for one frame in the middle
+    Case k{"kscore_1", {}, 0.8, 0.9, 2};
+    for (int f = 0; f < 10; ++f)
+      k.frames.push_back({{1}, {{f != 5 ? a : b, 1}}});
+    cases.push_back(k);
+  }
+  {  // kscore_2: a, then b, then c
+    Case k{"kscore_2", {}, 0.8, 0.4, 2};
+    for (int f = 0; f < 10; ++f)
+      k.frames.push_back({{1}, {{f < 4 ? a : (f < 7 ? b : c), 1}}});
+    cases.push_back(k);
+  }
+  {  // kscore_4: a new hypothesis every frame
+    Case k{"kscore_4", {}, 0.1, 0.1, 9};
+    for (int f = 0; f < 10; ++f)
+      k.frames.push_back({{1}, {{10 + f, 1}}});
+    cases.push_back(k);
+  }
+  {  // kscore_6
+    Case k{"kscore_6", {}, 0.5, 0.625, 1};
+    for (int f = 0; f < 10; ++f) {
+      Frame fr{{1}, {}};
+      if (f >= 2 && f <= 6) fr.hyps.push_back({a, 1});
+      if (f == 7) fr.hyps.push_back({b, 1});
+      k.frames.push_back(fr);
+    }
+    cases.push_back(k);
+  }
+  {  // kscore_8: object 1 a then b, object 2 b then c; object 1 leaves for the last 2 frames
+    Case k{"kscore_8", {}, 0.875, 0.625, 2};
+    for (int f = 0; f < 9; ++f) {
+      if (f < 3)
+        k.frames.push_back({{1, 2}, {{a, 1}, {b, 2}}});
+      else if (f < 7)
+        k.frames.push_back({{1, 2}, {{b, 1}, {c, 2}}});
+      else
+        k.frames.push_back({{2}, {{c, 2}}});
+    }
+    cases.push_back(k);
+  }
+  {  // kscore_10: as kscore_9 with the last frame's object gone (a false positive)
+    Case k{"kscore_10", {}, 0.8, 0.580645161290, 2};
+    for (int f = 0; f < 9; ++f) {
+      if (f < 3)
+        k.frames.push_back({{1, 2}, {{a, 1}, {d, 2}}});
+      else if (f < 7)
+        k.frames.push_back({{1, 2}, {{b, 1}, {c, 2}}});
+      else if (f == 7)
+        k.frames.push_back({{2}, {{c, 2}}});
+      else
+        k.frames.push_back({{}, {{c, 0}}});
+    }
+    cases.push_back(k);
+  }
+  {  // kscore_11: one hypothesis moves from object 1 to object 2 (no switch: 2 is new to it)
+    Case k{"kscore_11", {}, 0.5, 0.380952380952, 0};
+    for (int f = 0; f < 7; ++f)
+      k.frames.push_back({{1, 2}, {{a, f < 4 ? 1 : 2}}});
+    cases.push_back(k);
+  }
+  {  // kscore_12: object 1 then object 2, one hypothesis
+    Case k{"kscore_12", {}, 1.0, 0.555555555556, 0};
+    for (int f = 0; f < 9; ++f)
+      k.frames.push_back({{f < 5 ? 1 : 2}, {{a, f < 5 ? 1 : 2}}});
+    cases.push_back(k);
+  }
+  {  // correct_average (Bernardin & Stiefelhagen, fig. 3)
+    Case k{"correct_average", {}, 0.2, 0.0, 0};
+    for (int f = 0; f < 4; ++f)
+      k.frames.push_back({{1, 2, 3, 4}, {}});
+    for (int f = 0; f < 4; ++f)
+      k.frames.push_back({{4}, {{4, 4}}});
+    k.idf1 = 2.0 * 4 / (20 + 4);
+    cases.push_back(k);
+  }
+  for (const Case& k : cases) {
+    const MotScore s = score_frames(k.frames);
+    EXPECT_NEAR(s.mota, k.mota, 1e-9) << k.name;
+    EXPECT_NEAR(s.idf1, k.idf1, 1e-9) << k.name;
+    EXPECT_EQ(s.id_switches, k.switches) << k.name;
+  }
+}
+
 TEST(MotScore, ConfZeroGroundTruthIsNotScored) {
   // Object 2 is marked conf 0: it is neither missed nor matched; a tracker box over it is a
   // false positive (as TrackEval and py-motmetrics score MOT15).

@@ -19,15 +19,39 @@ void write_text(const std::string& path, const std::string& text) {
 
 class TrackLogTest : public test::TempDirTest {};
 
+TEST_F(TrackLogTest, ReadsTheIdColumnAndLogsWrittenBeforeIt) {
+  const auto with_id = eval::parse_track_csv(
+      "frame,id,x,y,w,h,vx,vy,mode,lost,ms\n1,4,1,2,3,4,0,0,local,0,1\n1,9,5,6,7,8,0,0,local,1,1\n",
+      "new");
+  ASSERT_EQ(with_id.size(), 2u);
+  EXPECT_EQ(with_id[0].id, 4);
+  EXPECT_EQ(with_id[1].id, 9);
+  EXPECT_EQ(with_id[1].box, cv::Rect2f(5, 6, 7, 8));
+  const auto old =
+      eval::parse_track_csv("frame,x,y,w,h,vx,vy,mode,lost,ms\n1,1,2,3,4,0,0,local,0,1\n", "old");
+  ASSERT_EQ(old.size(), 1u);
+  EXPECT_EQ(old[0].id, 1);
+  EXPECT_EQ(old[0].box, cv::Rect2f(1, 2, 3, 4));
+  for (const char* bad :
+       {"1,0,1,2,3,4,0,0,local,0,1\n", "1,x,1,2,3,4,0,0,local,0,1\n", "1,2,3,4,0,0,local,0,1\n"}) {
+    const std::string m = test::error_message([&] {
+      eval::parse_track_csv(std::string("frame,id,x,y,w,h,vx,vy,mode,lost,ms\n") + bad, "b");
+    });
+    EXPECT_NE(m.find("b:2: "), std::string::npos) << m;
+  }
+}
+
 TEST_F(TrackLogTest, RowsReadBackAsWritten) {
-  TrackRecord r{7, {1.256f, 2, 30, 40}, {-0.0004f, 1.5f}, TrackRecord::Mode::Global, true, 2.5};
-  EXPECT_EQ(eval::track_csv_row(r), "7,1.26,2.00,30.00,40.00,0.000,1.500,global,1,2.500\n");
-  EXPECT_EQ(eval::track_json_object(r),
-            R"({"frame":7,"x":1.26,"y":2.0,"w":30.0,"h":40.0,"vx":0.0,"vy":1.5,"mode":"global",)"
-            R"("lost":true,"ms":2.5})");
+  TrackRecord r{7, {1.256f, 2, 30, 40}, {-0.0004f, 1.5f}, TrackRecord::Mode::Global, true, 2.5, 3};
+  EXPECT_EQ(eval::track_csv_row(r), "7,3,1.26,2.00,30.00,40.00,0.000,1.500,global,1,2.500\n");
+  EXPECT_EQ(
+      eval::track_json_object(r),
+      R"({"frame":7,"id":3,"x":1.26,"y":2.0,"w":30.0,"h":40.0,"vx":0.0,"vy":1.5,"mode":"global",)"
+      R"("lost":true,"ms":2.5})");
   const std::vector<TrackRecord> back = eval::parse_track_csv(
       std::string(eval::kTrackCsvHeader) + "\n" + eval::track_csv_row(r), "memory");
   ASSERT_EQ(back.size(), 1u);
+  EXPECT_EQ(back[0].id, 3);
   EXPECT_EQ(back[0].frame, 7);
   EXPECT_FLOAT_EQ(back[0].box.x, 1.26f);
   EXPECT_EQ(back[0].mode, TrackRecord::Mode::Global);

@@ -32,11 +32,16 @@ mkdir -p "$data/middlebury" "$data/kitti" "$data/sintel" "$data/flyingchairs" "$
 cat >"$work/stub/roiflow" <<STUB
 #!/usr/bin/env bash
 if [[ \$1 == eval ]]; then cat "$work/eval_\$(basename "\$2").csv"; exit 0; fi
+if [[ \$1 == motion-check ]]; then
+  cat "$work/motion_\$(basename "\$2").json"
+  exit "\$(cat "$work/motion.rc")"
+fi
 if [[ \$1 == track ]]; then
   while [[ \$# -gt 0 ]]; do
     case \$1 in
       --log) cp "$work/track.csv" "\$2"; shift ;;
       --summary) echo '{"tracker_fps": 1000.0}' >"\$2"; shift ;;
+      --mot) cp "$work/mot.txt" "\$2"; shift ;;
     esac
     shift
   done
@@ -114,6 +119,51 @@ track_csv 20
 expect pass "track gate, an absent-target frame is not scored" tgate
 track_csv 19
 expect fail "track gate, one frame short with an absent-target frame" tgate
+
+# --- mot_gate.sh: the stub writes $work/mot.txt as the --mot output and prints
+# $work/motion_<video>.json for motion-check; `score --mot` is the real roiflow, against a
+# made-up ground truth of 795 frames and 19 people.
+mdata="$work/mdata"
+mkdir -p "$mdata/video" "$mdata/mot/PETS09-S2L1/gt"
+: >"$mdata/video/opencv_vtest.avi"
+: >"$mdata/video/bgslibrary_video02.avi"
+mgt="$mdata/mot/PETS09-S2L1/gt/gt.txt"
+for ((f = 1; f <= 795; ++f)); do
+  echo "$f,$((f % 19 + 1)),$((10 + f % 50)),20,30,80,1,1,1"
+  if ((f <= 771)); then  # 795 + 771 x 5 = 4650 boxes, as PETS09-S2L1's
+    for ((k = 1; k <= 5; ++k)); do echo "$f,$(((f + k) % 19 + 1)),$((100 + 60 * k)),200,30,80,1,1,1"; done
+  fi
+done >"$mgt"
+motion_json() {  # motion_json VIDEO FRAMES LONGEST RC (RC: the stub's exit code for every video)
+  printf '{\n  "frames": %s,\n  "objects": 3,\n  "longest_run": %s,\n  "violations": []\n}\n' \
+    "$2" "$3" >"$work/motion_$1.json"
+  echo "$4" >"$work/motion.rc"
+}
+mgate() { "$repo/scripts/mot_gate.sh" "$mdata" "$work/stub"; }
+cut -d, -f1-6 "$mgt" | sed 's/$/,1,-1,-1,-1/' >"$work/mot.txt"
+track_csv 20
+motion_json opencv_vtest.avi 795 3 0
+motion_json bgslibrary_video02.avi 748 3 0
+expect pass "mot gate, tracker output equal to the ground truth" mgate
+sed -i '100s/.*/100,5,nan,20,30,80,1,-1,-1,-1/' "$work/mot.txt"
+expect fail "mot gate, a NaN row in the MOT output" mgate
+head -n 400 "$mgt" | cut -d, -f1-6 | sed 's/$/,1,-1,-1,-1/' >"$work/mot.txt"
+expect fail "mot gate, half the frames missing (MOTA below the floor)" mgate
+cut -d, -f1-6 "$mgt" | sed 's/$/,1,-1,-1,-1/' >"$work/mot.txt"
+motion_json bgslibrary_video02.avi 700 3 0
+expect fail "mot gate, motion check read too few frames" mgate
+motion_json bgslibrary_video02.avi 748 nan 0
+expect fail "mot gate, motion check longest run nan" mgate
+motion_json bgslibrary_video02.avi 748 3 0
+motion_json opencv_vtest.avi 795 45 1
+expect fail "mot gate, an object found on empty background for 45 frames" mgate
+motion_json opencv_vtest.avi 795 45 0
+expect fail "mot gate, a 45-frame run even with exit 0" mgate
+motion_json opencv_vtest.avi 795 3 0
+head -n 700 "$mgt" >"$work/gt_short.txt" && cp "$mgt" "$work/gt_full.txt" && cp "$work/gt_short.txt" "$mgt"
+expect fail "mot gate, ground truth of 700 frames" mgate
+cp "$work/gt_full.txt" "$mgt"
+expect pass "mot gate, good again" mgate
 
 # --- dropin_gate.sh: a stub roiflow (track copies $work/dcli.csv to --log; batch prints
 # $work/batch<N>.txt and writes $work/batch.csv into --out) and a stub gst-launch-1.0 (copies

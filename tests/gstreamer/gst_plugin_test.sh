@@ -34,7 +34,7 @@ gst-launch-1.0 -q videotestsrc num-buffers=20 pattern=ball \
   fail "gst-launch-1.0 failed: $(cat "$tmp/err")"
 lines=$(wc -l <"$tmp/t.csv")
 [[ $lines == 21 ]] || fail "track log has $lines lines, expected 21"
-[[ $(head -1 "$tmp/t.csv") == "frame,x,y,w,h,vx,vy,mode,lost,ms" ]] || fail "track log header"
+[[ $(head -1 "$tmp/t.csv") == "frame,id,x,y,w,h,vx,vy,mode,lost,ms" ]] || fail "track log header"
 
 # A bad property: gst-launch fails and says why.
 if gst-launch-1.0 -q videotestsrc num-buffers=2 ! video/x-raw,format=GRAY8 \

@@ -31,7 +31,7 @@ def videos(tmp_path_factory):
     paths = []
     for i, frames in enumerate((300, 300, 300)):
         p = d / f"clip{i}.avi"
-        cli("track", f"synthetic:{frames}:320x240", "--out", p, "--no-progress",
+        cli("track", f"synthetic:{frames}:320x240", "--single", "--out", p, "--no-progress",
             "--max-frames", frames - 10 * i)
         paths.append(p)
     (d / "list.txt").write_text("# three clips\n" + "".join(f"{p.name}\n" for p in paths))
@@ -51,7 +51,7 @@ def check_complete(folder):
     status = json.loads((folder / "status.json").read_text())
     assert status["status"] == "done"
     rows = (folder / "track.csv").read_text().splitlines()
-    assert rows[0] == "frame,x,y,w,h,vx,vy,mode,lost,ms"
+    assert rows[0] == "frame,id,x,y,w,h,vx,vy,mode,lost,ms"
     assert len(rows) == status["frames"] + 1
     assert [int(r.split(",")[0]) for r in rows[1:]] == list(range(1, status["frames"] + 1))
     return status
@@ -97,7 +97,7 @@ def test_batch_kill_and_resume(videos, tmp_path):
     assert all(float(r["fps"]) > 0 and float(r["seconds"]) > 0 for r in rows)
 
     # The same as roiflow track's log (ms aside).
-    cli("track", videos / "clip1.avi", "--log", tmp_path / "cli.csv", "--no-progress")
+    cli("track", videos / "clip1.avi", "--single", "--log", tmp_path / "cli.csv", "--no-progress")
     strip = lambda text: [",".join(line.split(",")[:9]) for line in text.splitlines()]  # noqa: E731
     assert strip((out / "clip1" / "track.csv").read_text()) == strip((tmp_path / "cli.csv").read_text())
 

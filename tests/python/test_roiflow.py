@@ -260,7 +260,7 @@ def test_tracker_follows_init_boxes():
 def test_track_iterator_equals_cli_log(tmp_path):
     source = "synthetic:40:320x240"
     log = tmp_path / "t.csv"
-    cli("track", source, "--log", log, "--no-progress")
+    cli("track", source, "--single", "--log", log, "--no-progress")
     rows = open(log).read().splitlines()[1:]
     assert len(rows) == 40
     seen = 0
@@ -270,11 +270,11 @@ def test_track_iterator_equals_cli_log(tmp_path):
         if objects:
             o = objects[0]
             assert o.id == 1
-            assert [f"{v:.2f}" for v in o.box] == fields[1:5], (index, o, row)
-            assert o.mode == fields[7] and int(o.lost) == int(fields[8])
+            assert [f"{v:.2f}" for v in o.box] == fields[2:6], (index, o, row)
+            assert o.mode == fields[8] and int(o.lost) == int(fields[9])
             seen += 1
         else:
-            assert fields[8] == "1"  # no target yet: logged as lost
+            assert fields[9] == "1"  # no target yet: logged as lost
     assert seen > 20  # the moving vehicle was found and followed
     it = roiflow.track(source, max_frames=5)
     assert it.size == (320, 240)

@@ -4,7 +4,9 @@
 
 #include <limits>
 #include <opencv2/core.hpp>
+#include <set>
 #include <string>
+#include <tuple>
 
 #include "flow/color_code.hpp"
 #include "test_util.hpp"
@@ -213,6 +215,45 @@ TEST(Annotate, BadInputThrowsNamingTheValue) {
               annotate_frame(gray_image(), TrackAnnotation{}, style);
             }).find("thickness"),
             std::string::npos);
+}
+
+}  // namespace
+
+namespace {
+
+TEST(AnnotateObjects, EachIdInItsOwnColourWithLabelAndArrow) {
+  std::set<std::tuple<double, double, double>> colours;
+  for (long long id = 1; id <= 20; ++id) {
+    const cv::Scalar c = report::id_color(id);
+    colours.insert({c[0], c[1], c[2]});
+    EXPECT_EQ(c, report::id_color(id));  // stable
+  }
+  EXPECT_EQ(colours.size(), 20u);
+
+  report::ObjectsAnnotation frame;
+  frame.index = 9;
+  frame.objects = {{3, {10, 10, 30, 40}, {0.f, 0.f}, false, {}},
+                   {7, {90, 50, 30, 40}, {3.f, 0.f}, false, {}},
+                   {8, {60, 20, 20, 20}, {0.f, 0.f}, true, {}}};
+  AnnotateStyle style = no_text();
+  const cv::Mat out = report::annotate_objects(gray_image(), frame, style);
+  ASSERT_EQ(out.type(), CV_8UC3);
+  // Each box's outline in its id's colour, inside its own box's area only.
+  EXPECT_GT(count_color(out, cv::Rect(8, 8, 34, 44), report::id_color(3)), 60);
+  EXPECT_EQ(count_color(out, cv::Rect(88, 48, 34, 44), report::id_color(3)), 0);
+  EXPECT_GT(count_color(out, cv::Rect(88, 48, 34, 44), report::id_color(7)), 60);
+  // The lost one is dashed: fewer pixels than a full outline of its size.
+  const int lost = count_color(out, cv::Rect(58, 18, 24, 24), report::id_color(8));
+  EXPECT_GT(lost, 10);
+  EXPECT_LT(lost, 2 * 2 * 80);
+  // Velocity arrow of id 7 to the right of its centre, beyond its box.
+  EXPECT_GT(count_color(out, cv::Rect(121, 66, 30, 8), report::id_color(7)), 5);
+  // The label "#7" above its box (text pixels in its colour, anti-aliased, so look for any).
+  const cv::Mat above = out(cv::Rect(90, 35, 30, 15));
+  EXPECT_GT(cv::countNonZero(above.reshape(1) != kGray), 10);
+  // The status line.
+  const cv::Mat with_text = report::annotate_objects(gray_image(), frame);
+  EXPECT_GT(cv::countNonZero(with_text(cv::Rect(0, 0, 100, 12)).reshape(1) != kGray), 50);
 }
 
 }  // namespace

@@ -47,10 +47,10 @@ class TrackLogTest : public test::TempDirTest {};
 TEST_F(TrackLogTest, CsvHasExactHeaderAndFixedDecimals) {
   write_all(path("t.csv"), sample_records());
   EXPECT_EQ(read_text(path("t.csv")),
-            "frame,x,y,w,h,vx,vy,mode,lost,ms\n"
-            "1,70.00,51.00,107.00,87.00,0.000,0.000,global,0,12.500\n"
-            "2,71.26,50.50,107.00,86.99,1.256,0.000,local,0,0.432\n"
-            "3,300.00,200.25,0.00,0.00,-3.500,2.000,global,1,7.000\n");
+            "frame,id,x,y,w,h,vx,vy,mode,lost,ms\n"
+            "1,1,70.00,51.00,107.00,87.00,0.000,0.000,global,0,12.500\n"
+            "2,1,71.26,50.50,107.00,86.99,1.256,0.000,local,0,0.432\n"
+            "3,1,300.00,200.25,0.00,0.00,-3.500,2.000,global,1,7.000\n");
 }
 
 TEST_F(TrackLogTest, CsvRoundTripKeepsTheWrittenValues) {
@@ -100,8 +100,8 @@ TEST_F(TrackLogTest, JsonIsValidAfterEveryRecord) {
   for (const auto& item : doc[1].items())
     keys.push_back(item.key());
   std::sort(keys.begin(), keys.end());
-  EXPECT_EQ(keys, (std::vector<std::string>{"frame", "h", "lost", "mode", "ms", "vx", "vy", "w",
-                                            "x", "y"}));
+  EXPECT_EQ(keys, (std::vector<std::string>{"frame", "h", "id", "lost", "mode", "ms", "vx", "vy",
+                                            "w", "x", "y"}));
   EXPECT_EQ(doc[1]["frame"], 2);
   EXPECT_TRUE(doc[1]["frame"].is_number_integer());
   EXPECT_EQ(doc[1]["mode"], "local");

@@ -1,0 +1,66 @@
+// roiflow motion-check VIDEO LOG: objects a track log reports found while their box holds no
+// moving pixels or has collapsed (pipeline::check_motion). Exit 0 when no run exceeds
+// --max-run frames, 1 otherwise (or on bad input).
+//
+//   roiflow motion-check ../shared/data/video/opencv_vtest.avi out/track.csv --format json
+#include <CLI/CLI.hpp>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "cli_common.hpp"
+#include "eval/track_log.hpp"
+#include "pipeline/motion_check.hpp"
+#include "stages/video_source.hpp"
+
+namespace roiflow::cli {
+
+void add_motion_check_command(CLI::App& app, int& exit_code) {
+  struct Cmd {
+    std::string video, log, format = "table";
+    pipeline::MotionCheckParams params;
+  };
+  static Cmd cmd;
+  CLI::App* sub = app.add_subcommand(
+      "motion-check",
+      "Check a track log against the video's moving pixels: no object reported found on empty "
+      "background or collapsed for more than --max-run frames");
+  sub->add_option("VIDEO", cmd.video, "the video the log was made from")->required();
+  sub->add_option("LOG", cmd.log, "track log (.csv, with or without the id column)")->required();
+  sub->add_option("--max-run", cmd.params.max_run, "longest run allowed, frames")
+      ->check(CLI::Range(0LL, 1000000LL))
+      ->capture_default_str();
+  sub->add_option("--min-side", cmd.params.min_side, "a box narrower than this has collapsed")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
+  sub->add_option("--format", cmd.format, "table or json")
+      ->check(CLI::IsMember({"table", "json"}))
+      ->capture_default_str();
+  sub->callback([&exit_code] {
+    const std::vector<eval::TrackRecord> log = eval::read_track_csv(cmd.log);
+    stages::VideoSource video(cmd.video);
+    const pipeline::MotionCheck c =
+        pipeline::check_motion([&] { return video.next(); }, log, cmd.params);
+    nlohmann::ordered_json violations = nlohmann::json::array();
+    for (const pipeline::MotionViolation& v : c.violations)
+      violations.push_back({{"id", v.id}, {"first", v.first}, {"last", v.last}, {"what", v.what}});
+    if (cmd.format == "json") {
+      const nlohmann::ordered_json doc = {{"frames", c.frames},      {"objects", c.objects},
+                                          {"records", c.records},    {"still", c.still},
+                                          {"small", c.small},        {"longest_run", c.longest},
+                                          {"violations", violations}};
+      std::cout << doc.dump(2) << "\n";
+    } else {
+      std::cout << "frames " << c.frames << ", objects " << c.objects << ", found records "
+                << c.records << ": without moving pixels " << c.still << ", collapsed " << c.small
+                << ", longest run " << c.longest << " frames (allowed " << cmd.params.max_run
+                << ")\n";
+      for (const pipeline::MotionViolation& v : c.violations)
+        std::cout << "  id " << v.id << " frames " << v.first << "-" << v.last << ": " << v.what
+                  << "\n";
+    }
+    exit_code = c.violations.empty() ? 0 : 1;
+  });
+}
+
+}  // namespace roiflow::cli

@@ -1,0 +1,244 @@
+#include "stages/motion_detector.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/background_segm.hpp>
+#include <string>
+
+#include "core/error.hpp"
+#include "core/text.hpp"
+
+namespace roiflow::stages {
+
+void MotionDetectorParams::validate() const {
+  auto fail = [](const std::string& what) { throw Error("motion detector: " + what); };
+  if (history < 2) fail("history must be >= 2, got " + number_text(history));
+  if (!(var_threshold > 0) || !std::isfinite(var_threshold))
+    fail("var_threshold must be > 0, got " + number_text(var_threshold));
+  if (work_width < 0 || work_width > 1 << 16)
+    fail("work_width must be in 0..65536, got " + number_text(work_width));
+  if (warmup < 0) fail("warmup must be >= 0, got " + number_text(warmup));
+  if (open < 0 || open > 64) fail("open must be in 0..64, got " + number_text(open));
+  if (close < 0 || close > 64) fail("close must be in 0..64, got " + number_text(close));
+  if (!(min_area >= 1) || !std::isfinite(min_area))
+    fail("min_area must be >= 1, got " + number_text(min_area));
+  if (!(split_valley >= 0 && split_valley < 1))
+    fail("split_valley must be in [0, 1), got " + number_text(split_valley));
+  if (!(split_width > 0 && split_width < 4))
+    fail("split_width must be in (0, 4), got " + number_text(split_width));
+  if (close_h < 0 || close_h > 64) fail("close_h must be in 0..64, got " + number_text(close_h));
+  if (!(join_gap >= 0 && join_gap <= 2))
+    fail("join_gap must be in [0, 2], got " + number_text(join_gap));
+  if (!(merge_overlap > 0 && merge_overlap <= 1))
+    fail("merge_overlap must be in (0, 1], got " + number_text(merge_overlap));
+}
+
+double Foreground::moving_share(const cv::Rect2f& box) const {
+  if (integral.empty() || !(box.width > 0) || !(box.height > 0)) return 0;
+  const double s = scale;
+  const int x0 = std::clamp(static_cast<int>(std::floor(box.x / s)), 0, mask.cols);
+  const int y0 = std::clamp(static_cast<int>(std::floor(box.y / s)), 0, mask.rows);
+  const int x1 = std::clamp(static_cast<int>(std::ceil((box.x + box.width) / s)), 0, mask.cols);
+  const int y1 = std::clamp(static_cast<int>(std::ceil((box.y + box.height) / s)), 0, mask.rows);
+  if (x1 <= x0 || y1 <= y0) return 0;
+  const int sum = integral.at<int>(y1, x1) - integral.at<int>(y0, x1) - integral.at<int>(y1, x0) +
+                  integral.at<int>(y0, x0);
+  return static_cast<double>(sum) / (static_cast<double>(x1 - x0) * (y1 - y0));
+}
+
+struct MotionDetector::Impl {
+  cv::Ptr<cv::BackgroundSubtractorMOG2> model;
+  cv::Size frame_size;
+  int scale = 1;
+  cv::Mat small, raw;
+  long long observed = 0;
+};
+
+MotionDetector::MotionDetector(const MotionDetectorParams& params)
+    : params_(params), impl_(std::make_shared<Impl>()) {
+  params_.validate();
+  // Shadows are labelled (127) and then count as background: a pedestrian's or a car's shadow
+  // is not the object, and would merge neighbours into one blob.
+  impl_->model =
+      cv::createBackgroundSubtractorMOG2(params_.history, params_.var_threshold, params_.shadows);
+  impl_->model->setShadowThreshold(params_.shadow_threshold);
+}
+
+Foreground MotionDetector::observe(const cv::Mat& image) {
+  if (image.empty() || image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3))
+    throw Error("motion detector: frame must be 8-bit gray or BGR");
+  Impl& s = *impl_;
+  if (s.frame_size.empty()) {
+    s.frame_size = image.size();
+    s.scale = params_.work_width > 0
+                  ? std::max(1, static_cast<int>(std::lround(static_cast<double>(image.cols) /
+                                                             params_.work_width)))
+                  : 1;
+  } else if (image.size() != s.frame_size) {
+    throw Error("motion detector: frame size " + number_text(image.cols) + "x" +
+                number_text(image.rows) + " differs from the first frame's " +
+                number_text(s.frame_size.width) + "x" + number_text(s.frame_size.height));
+  }
+  const cv::Mat* input = &image;
+  if (s.scale > 1) {
+    // A whole factor: INTER_AREA averages scale x scale blocks (cheap).
+    cv::resize(image, s.small,
+               cv::Size(std::max(1, image.cols / s.scale), std::max(1, image.rows / s.scale)), 0, 0,
+               cv::INTER_AREA);
+    input = &s.small;
+  }
+  s.model->apply(*input, s.raw);
+  ++s.observed;
+  Foreground fg;
+  fg.observed = s.observed;
+  fg.scale = s.scale;
+  fg.frame_size = s.frame_size;
+  cv::threshold(s.raw, fg.mask, 200, 255, cv::THRESH_BINARY);  // shadows (127) out
+  if (params_.open > 0) {
+    cv::morphologyEx(fg.mask, fg.mask, cv::MORPH_OPEN,
+                     cv::getStructuringElement(cv::MORPH_ELLIPSE, {params_.open, params_.open}));
+  }
+  cv::Mat ones;
+  cv::threshold(fg.mask, ones, 0, 1, cv::THRESH_BINARY);
+  cv::integral(ones, fg.integral, CV_32S);
+  return fg;
+}
+
+namespace {
+
+bool stacked(const cv::Rect2f& a, const cv::Rect2f& b, double join_gap) {
+  if (join_gap <= 0) return false;
+  const double overlap_x = std::min(a.x + a.width, b.x + b.width) - std::max(a.x, b.x);
+  if (overlap_x < 0.5 * std::min(a.width, b.width)) return false;
+  const double gap = std::max(a.y, b.y) - std::min(a.y + a.height, b.y + b.height);
+  return gap <= join_gap * std::max(a.height, b.height);
+}
+
+// Splits the component `label` over `box` (work resolution) at valleys of its column profile of
+// moving pixels (`mask`, before the closing bridged the gaps between neighbours); appends the
+// parts' tight boxes.
+void split_blob(const cv::Mat& labels, const cv::Mat& mask, int label, cv::Rect box, double valley,
+                double min_part_share, int depth, std::vector<cv::Rect>& out) {
+  std::vector<int> cols(static_cast<std::size_t>(box.width), 0);
+  int top = box.br().y, bottom = box.y - 1, left = box.br().x, right = box.x - 1;
+  for (int y = box.y; y < box.br().y; ++y) {
+    const int* row = labels.ptr<int>(y);
+    const std::uint8_t* m = mask.ptr<std::uint8_t>(y);
+    for (int x = box.x; x < box.br().x; ++x) {
+      if (row[x] != label || m[x] == 0) continue;
+      ++cols[static_cast<std::size_t>(x - box.x)];
+      top = std::min(top, y);
+      bottom = std::max(bottom, y);
+      left = std::min(left, x);
+      right = std::max(right, x);
+    }
+  }
+  if (bottom < top) return;
+  // Tight vertically only: the columns between a cut and the object are kept (on PETS09 the
+  // wider parts match the annotated boxes better).
+  (void)left;
+  (void)right;
+  box = cv::Rect(box.x, top, box.width, bottom - top + 1);
+  const int min_part = std::max(2, static_cast<int>(box.height * min_part_share));
+  int best = -1;
+  double best_ratio = valley;
+  if (depth < 4 && valley > 0 && box.width >= 2 * min_part) {
+    std::vector<int> left_peak(cols.size()), right_peak(cols.size());
+    int peak = 0;
+    for (std::size_t i = 0; i < cols.size(); ++i)
+      left_peak[i] = peak = std::max(peak, cols[i]);
+    peak = 0;
+    for (std::size_t i = cols.size(); i-- > 0;)
+      right_peak[i] = peak = std::max(peak, cols[i]);
+    for (int x = min_part; x <= box.width - min_part; ++x) {
+      const std::size_t i = static_cast<std::size_t>(x);
+      const int lo = std::min(left_peak[i - 1], i + 1 < cols.size() ? right_peak[i + 1] : 0);
+      if (lo <= 0) continue;
+      const double ratio = static_cast<double>(cols[i]) / lo;
+      if (ratio < best_ratio) {
+        best_ratio = ratio;
+        best = x;
+      }
+    }
+  }
+  if (best < 0) {
+    out.push_back(box);
+    return;
+  }
+  split_blob(labels, mask, label, cv::Rect(box.x, box.y, best, box.height), valley, min_part_share,
+             depth + 1, out);
+  split_blob(labels, mask, label, cv::Rect(box.x + best, box.y, box.width - best, box.height),
+             valley, min_part_share, depth + 1, out);
+}
+
+}  // namespace
+
+std::vector<cv::Rect2f> merge_nested(std::vector<cv::Rect2f> boxes, double overlap,
+                                     double join_gap) {
+  bool merged = true;
+  while (merged) {
+    merged = false;
+    for (std::size_t i = 0; i < boxes.size() && !merged; ++i) {
+      for (std::size_t j = i + 1; j < boxes.size() && !merged; ++j) {
+        const double inter = (boxes[i] & boxes[j]).area();
+        const double smaller = std::min(boxes[i].area(), boxes[j].area());
+        if ((smaller > 0 && inter >= overlap * smaller) || stacked(boxes[i], boxes[j], join_gap)) {
+          boxes[i] = boxes[i] | boxes[j];
+          boxes.erase(boxes.begin() + static_cast<std::ptrdiff_t>(j));
+          merged = true;
+        }
+      }
+    }
+  }
+  return boxes;
+}
+
+std::vector<Detection> detect_objects(const Foreground& fg, const MotionDetectorParams& params) {
+  std::vector<Detection> out;
+  if (fg.empty() || fg.observed <= params.warmup) return out;
+  // A fresh buffer: the closing must not write into fg.mask (shared, read by other threads).
+  cv::Mat mask;
+  if (params.close <= 0) mask = fg.mask;
+  if (params.close > 0) {
+    const int h = params.close_h > 0 ? params.close_h : params.close;
+    cv::morphologyEx(fg.mask, mask, cv::MORPH_CLOSE,
+                     cv::getStructuringElement(cv::MORPH_ELLIPSE, {params.close, h}));
+  }
+  cv::Mat labels, stats, centroids;
+  const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
+  const float s = static_cast<float>(fg.scale);
+  const double min_small = params.min_area / (static_cast<double>(fg.scale) * fg.scale);
+  std::vector<cv::Rect2f> boxes;
+  for (int i = 1; i < n; ++i) {
+    const int w = stats.at<int>(i, cv::CC_STAT_WIDTH), h = stats.at<int>(i, cv::CC_STAT_HEIGHT);
+    // Speckle that survived the opening is dropped before the merge.
+    if (static_cast<double>(w) * h < 0.25 * min_small) continue;
+    std::vector<cv::Rect> parts;
+    const cv::Rect whole(stats.at<int>(i, cv::CC_STAT_LEFT), stats.at<int>(i, cv::CC_STAT_TOP), w,
+                         h);
+    if (params.split_valley > 0) {
+      split_blob(labels, fg.mask, i, whole, params.split_valley, params.split_width, 0, parts);
+    } else {
+      parts.push_back(whole);
+    }
+    for (const cv::Rect& r : parts) {
+      boxes.emplace_back(static_cast<float>(r.x) * s, static_cast<float>(r.y) * s,
+                         static_cast<float>(r.width) * s, static_cast<float>(r.height) * s);
+    }
+  }
+  const cv::Rect2f frame(0.f, 0.f, static_cast<float>(fg.frame_size.width),
+                         static_cast<float>(fg.frame_size.height));
+  for (const cv::Rect2f& b :
+       merge_nested(std::move(boxes), params.merge_overlap, params.join_gap)) {
+    const cv::Rect2f box = b & frame;
+    if (box.area() < params.min_area) continue;
+    out.push_back({box, (box.tl() + box.br()) * 0.5f, box.area()});
+  }
+  std::sort(out.begin(), out.end(),
+            [](const Detection& a, const Detection& b) { return a.score > b.score; });
+  return out;
+}
+
+}  // namespace roiflow::stages

@@ -1,0 +1,276 @@
+#include "stages/multi_tracker.hpp"
+
+#include <gtest/gtest.h>
+
+#include <map>
+#include <opencv2/imgproc.hpp>
+#include <set>
+#include <sstream>
+
+#include "mot_scene.hpp"
+#include "stages/motion_detector.hpp"
+#include "test_util.hpp"
+
+namespace roiflow {
+namespace {
+
+using stages::MotFrame;
+using stages::MultiTracker;
+using stages::MultiTrackerParams;
+using test::MotObject;
+using test::MotScene;
+
+TEST(BoxFilter, LearnsAConstantVelocity) {
+  stages::BoxFilter f = stages::BoxFilter::start({100, 50, 20, 40});
+  for (int t = 1; t <= 20; ++t) {
+    f.predict();
+    f.correct_box(cv::Rect2f(100.f + 3.f * t, 50.f - 1.f * t, 20, 40));
+  }
+  EXPECT_NEAR(f.velocity().x, 3.0, 0.1);
+  EXPECT_NEAR(f.velocity().y, -1.0, 0.1);
+  f.predict();  // the prediction carries the motion on
+  EXPECT_NEAR(f.box().x, 100 + 3 * 21, 0.5);
+  EXPECT_NEAR(f.box().width, 20, 0.5);
+  f.correct_centre({f.box().x + 10 + 5, f.box().y + 20}, 40);  // LK says 5 px further right
+  EXPECT_GT(f.box().x, 100 + 3 * 21 + 2);
+}
+
+TEST(MergeNested, JoinsNestedAndStackedBoxesOnly) {
+  const auto merged = stages::merge_nested(
+      {{10, 10, 20, 40}, {12, 20, 8, 8}, {100, 10, 20, 20}, {100, 34, 20, 20}, {200, 0, 10, 10}},
+      0.6, 0.3);
+  ASSERT_EQ(merged.size(), 3u);
+  EXPECT_EQ(merged[0], cv::Rect2f(10, 10, 20, 40));   // the nested one joined it
+  EXPECT_EQ(merged[1], cv::Rect2f(100, 10, 20, 44));  // stacked with a 4 px gap: one object
+  EXPECT_EQ(merged[2], cv::Rect2f(200, 0, 10, 10));
+  EXPECT_EQ(stages::merge_nested({{100, 10, 20, 20}, {100, 34, 20, 20}}, 0.6, 0).size(), 2u);
+}
+
+TEST(MotionDetector, FindsEveryMovingObject) {
+  // They appear once the background model has settled (its first frames learn fast).
+  MotScene scene({320, 240}, {{{-40, 40, 20, 50}, {2, 0}, 40},
+                              {{230, 130, 30, 30}, {-2, 1}, 40},
+                              {{100, 240, 16, 50}, {0, -4.f}, 40}});
+  stages::MotionDetectorParams p;
+  p.split_valley = 0.7;
+  stages::MotionDetector detector(p);
+  std::vector<stages::Detection> found;
+  stages::Foreground fg;
+  const int last = 55;
+  for (int t = 0; t <= last; ++t) {
+    fg = detector.observe(scene.frame(t));
+    found = stages::detect_objects(fg, p);
+  }
+  EXPECT_GT(fg.moving_share(scene.box(0, last)), 0.5);
+  EXPECT_LT(fg.moving_share({250, 10, 40, 40}), 0.05);  // static background
+  int matched = 0;
+  for (int i = 0; i < scene.count(); ++i) {
+    for (const stages::Detection& d : found)
+      if (test::box_iou(d.box, scene.box(static_cast<std::size_t>(i), last)) > 0.5) ++matched;
+  }
+  std::ostringstream boxes;
+  for (const stages::Detection& d : found)
+    boxes << " " << d.box;
+  EXPECT_EQ(matched, 3) << boxes.str();
+}
+
+TEST(DetectObjects, SplitsNeighboursAtTheValleyBetweenThem) {
+  stages::Foreground fg;
+  fg.observed = 100;
+  fg.frame_size = {200, 100};
+  fg.mask = cv::Mat::zeros(100, 200, CV_8U);
+  fg.mask(cv::Rect(20, 20, 16, 50)).setTo(255);  // two objects 3 px apart: closing joins them
+  fg.mask(cv::Rect(39, 22, 16, 50)).setTo(255);
+  fg.mask(cv::Rect(120, 20, 40, 30)).setTo(255);  // one wide object: no valley, no split
+  cv::integral(fg.mask / 255, fg.integral, CV_32S);
+  stages::MotionDetectorParams p;
+  p.work_width = 0;
+  p.split_valley = 0.7;
+  std::vector<stages::Detection> found = stages::detect_objects(fg, p);
+  std::sort(found.begin(), found.end(), [](const stages::Detection& a, const stages::Detection& b) {
+    return a.box.x < b.box.x;
+  });
+  std::ostringstream got;
+  for (const auto& d : found)
+    got << " " << d.box;
+  ASSERT_EQ(found.size(), 3u) << got.str();
+  EXPECT_EQ(found[0].box, cv::Rect2f(20, 20, 16, 50));
+  EXPECT_EQ(found[1].box, cv::Rect2f(36, 22, 19, 50));  // from the valley on
+  EXPECT_EQ(found[2].box, cv::Rect2f(120, 20, 40, 30));
+  p.split_valley = 0;
+  EXPECT_EQ(stages::detect_objects(fg, p).size(), 2u);
+}
+
+TEST(MotionDetector, RejectsBadParamsAndSizeChanges) {
+  stages::MotionDetectorParams p;
+  p.min_area = 0;
+  EXPECT_NE(test::error_message([&] { stages::MotionDetector d(p); }).find("min_area"),
+            std::string::npos);
+  stages::MotionDetector d;
+  d.observe(cv::Mat(100, 100, CV_8UC3, cv::Scalar::all(0)));
+  EXPECT_NE(test::error_message([&] { d.observe(cv::Mat(50, 100, CV_8UC3)); }).find("size"),
+            std::string::npos);
+}
+
+// Runs the tracker over a scene; per frame, the reported (found) objects by id.
+std::vector<std::map<long long, cv::Rect2f>> run(const MotScene& scene, int frames,
+                                                 const MultiTrackerParams& params = {},
+                                                 MotFrame* last = nullptr) {
+  MultiTracker tracker(params);
+  std::vector<std::map<long long, cv::Rect2f>> out;
+  for (int t = 0; t < frames; ++t) {
+    const cv::Mat bgr = scene.frame(t);
+    cv::Mat gray;
+    cv::cvtColor(bgr, gray, cv::COLOR_BGR2GRAY);
+    const MotFrame f = tracker.process(t, gray, bgr);
+    std::map<long long, cv::Rect2f> found;
+    for (const stages::TrackedObject& o : f.objects)
+      if (!o.lost) found[o.id] = o.box;
+    out.push_back(found);
+    if (last != nullptr) *last = f;
+  }
+  return out;
+}
+
+// For each scene object, the ids of the boxes that matched it best (IoU > 0.5) and the share of
+// its frames (from `from` on, while it is in view) where one did.
+struct Coverage {
+  std::set<long long> ids;
+  double covered = 0;
+};
+std::vector<Coverage> coverage(const MotScene& scene,
+                               const std::vector<std::map<long long, cv::Rect2f>>& found,
+                               int from) {
+  std::vector<Coverage> out(static_cast<std::size_t>(scene.count()));
+  const cv::Rect2f frame(0, 0, static_cast<float>(scene.size().width),
+                         static_cast<float>(scene.size().height));
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    int frames = 0, good = 0;
+    for (int t = from; t < static_cast<int>(found.size()); ++t) {
+      const cv::Rect2f truth = scene.box(i, t);
+      if (truth.area() <= 0 || (truth & frame).area() < 0.9 * truth.area()) continue;
+      bool hidden = false;  // overlapping another: either may be the one in front
+      for (std::size_t j = 0; j < out.size(); ++j)
+        if (j != i && (scene.box(j, t) & truth).area() > 0) hidden = true;
+      if (hidden) continue;
+      ++frames;
+      double best = 0.5;
+      long long best_id = 0;
+      for (const auto& [id, box] : found[static_cast<std::size_t>(t)]) {
+        const double o = test::box_iou(box, truth);
+        if (o > best) best = o, best_id = id;
+      }
+      if (best_id != 0) out[i].ids.insert(best_id);
+      good += best_id != 0 ? 1 : 0;
+    }
+    out[i].covered = frames > 0 ? static_cast<double>(good) / frames : 0;
+  }
+  return out;
+}
+
+TEST(MultiTracker, FollowsEveryObjectWithOneIdEach) {
+  MotScene scene({320, 240}, {{{20, 30, 20, 44}, {2.5f, 0.5f}, 8},
+                              {{250, 150, 26, 26}, {-2, -0.5f}, 8},
+                              {{140, 100, 18, 40}, {0.5f, 1.5f}, 20}});  // born later
+  MotFrame last;
+  const auto found = run(scene, 70, {}, &last);
+  const std::vector<Coverage> c = coverage(scene, found, 35);
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    EXPECT_EQ(c[i].ids.size(), 1u) << "object " << i;
+    EXPECT_GT(c[i].covered, 0.9) << "object " << i;
+  }
+  EXPECT_EQ(last.born, 3);
+  EXPECT_GE(last.global_activations, 1);
+}
+
+TEST(MultiTracker, KeepsIdsThroughACrossing) {
+  // Two objects of one size walk into each other and through: the blobs merge for several
+  // frames, where LK keeps them apart.
+  MotScene scene({320, 200}, {{{40, 80, 22, 46}, {3, 0}, 8}, {{258, 84, 22, 46}, {-3, 0}, 8}});
+  const auto found = run(scene, 80);
+  const std::vector<Coverage> c = coverage(scene, found, 30);
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    EXPECT_EQ(c[i].ids.size(), 1u) << "object " << i;
+    EXPECT_GT(c[i].covered, 0.8) << "object " << i;
+  }
+  ASSERT_FALSE(c[0].ids.empty());
+  ASSERT_FALSE(c[1].ids.empty());
+  EXPECT_NE(*c[0].ids.begin(), *c[1].ids.begin());
+}
+
+TEST(MultiTracker, ReportsNothingOnAStaticSceneAndEndsObjectsThatLeave) {
+  MotScene still({200, 150}, {});
+  for (const auto& f : run(still, 40))
+    EXPECT_TRUE(f.empty());
+  // An object crossing out of the right edge ends; nothing is reported at the border after.
+  MotScene leaving({200, 150}, {{{100, 50, 20, 40}, {4, 0}, 8}});
+  MotFrame last;
+  const auto found = run(leaving, 60, {}, &last);
+  EXPECT_GE(last.born, 1);
+  EXPECT_EQ(last.ended, last.born);  // everything it found has ended
+  for (int t = 40; t < 60; ++t)
+    EXPECT_TRUE(found[static_cast<std::size_t>(t)].empty()) << t;
+  // Every reported box is at least min_side wide and mostly inside the frame.
+  for (const auto& f : found) {
+    for (const auto& [id, box] : f) {
+      EXPECT_GE(box.width, 8);
+      EXPECT_GE((box & cv::Rect2f(0, 0, 200, 150)).area(), 0.5 * box.area());
+    }
+  }
+}
+
+TEST(MultiTracker, ObjectThatStopsEndsAndIsNotReportedOnEmptyBackground) {
+  // Moves for a while, then stands still: once the background model has learnt it, no moving
+  // pixels are left in its box and it must not stay reported as found there.
+  MotScene scene({200, 150}, {{{30, 50, 20, 40}, {3, 0}, 8, 30}});  // gone after frame 30
+  MultiTrackerParams p;
+  const auto found = run(scene, 90, p);
+  for (int t = 31 + p.max_lost + 2; t < 90; ++t)
+    EXPECT_TRUE(found[static_cast<std::size_t>(t)].empty()) << "frame " << t;
+}
+
+TEST(MultiTracker, FollowsKnownTargetsWithTheirIds) {
+  MotScene scene({240, 160}, {{{20, 40, 24, 40}, {2, 0}, 0}, {{180, 90, 24, 40}, {-2, 0}, 0}});
+  MultiTrackerParams p;
+  p.known = {{7, scene.box(0, 0)}, {9, scene.box(1, 0)}};
+  p.births = false;
+  const auto found = run(scene, 40, p);
+  for (int t = 0; t < 40; t += 5) {
+    const auto& f = found[static_cast<std::size_t>(t)];
+    ASSERT_EQ(f.count(7), 1u) << t;
+    ASSERT_EQ(f.count(9), 1u) << t;
+    EXPECT_GT(test::box_iou(f.at(7), scene.box(0, t)), 0.6)
+        << t << " " << f.at(7) << " " << scene.box(0, t);
+    EXPECT_GT(test::box_iou(f.at(9), scene.box(1, t)), 0.6) << t;
+  }
+}
+
+TEST(KnownTargets, ParsesAndRejects) {
+  const auto k = stages::parse_known_targets("# id,x,y,w,h\n3,1,2,30,40\n\n5,10.5,0,8,9\n", "t");
+  ASSERT_EQ(k.size(), 2u);
+  EXPECT_EQ(k[0].id, 3);
+  EXPECT_EQ(k[1].box, cv::Rect2f(10.5f, 0, 8, 9));
+  const std::pair<const char*, const char*> bad[] = {
+      {"1,2,3,4\n", "t:1: expected 5 fields"},
+      {"0,1,2,3,4\n", "t:1: id '0'"},
+      {"1,1,2,3,nan\n", "t:1: h 'nan'"},
+      {"1,1,2,0,4\n", "t:1: the box needs a positive"},
+      {"1,1,2,3,4\n1,5,6,7,8\n", "t:2: id 1 given twice"},
+      {"# nothing\n", "no target"}};
+  for (const auto& [text, expected] : bad) {
+    const std::string m = test::error_message([&] { stages::parse_known_targets(text, "t"); });
+    EXPECT_NE(m.find(expected), std::string::npos) << m;
+  }
+}
+
+TEST(MultiTrackerParams, RejectsBadValues) {
+  MultiTrackerParams p;
+  p.min_side = 0;
+  EXPECT_NE(test::error_message([&] { p.validate(); }).find("min_side"), std::string::npos);
+  p = {};
+  p.known = {{1, {0, 0, 10, 10}}, {1, {5, 5, 10, 10}}};
+  EXPECT_NE(test::error_message([&] { p.validate(); }).find("twice"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace roiflow
