@@ -74,7 +74,7 @@ void bm_track_objects(benchmark::State& state, int objects, cv::Size size, int t
     pipeline::MotRunOptions o;
     o.threads = threads;
     o.on_frame = [&](const pipeline::MotTrackedFrame& f) {
-      for (const stages::TrackedObject& t : f.output->objects) {
+      for (const stages::MotObject& t : f.output->objects) {
         if (t.lost) continue;
         eval::MotBox b;
         b.frame = static_cast<int>(f.output->index) + 1;

@@ -13,25 +13,15 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "pipeline/frame_graph_impl.hpp"
 #include "pipeline/tbb_executor.hpp"
 
 namespace roiflow::pipeline {
 namespace {
 
+using namespace frame_graph_impl;
+
 namespace tf = oneapi::tbb::flow;
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-// A decoded frame on its way through the pyramid levels.
-struct FrameMsg {
-  long long seq = 0;
-  std::shared_ptr<const stages::Frame> frame;
-  std::shared_ptr<flow::Pyramid> pyramid;  // filled level by level, then only read
-};
-
 // A frame or pair done with by `votes` consumers; retired when all of them have voted.
 struct RetireMsg {
   long long seq = 0;
@@ -501,42 +491,6 @@ RunReport run_mot(const FrameSource& source, const stages::MultiTrackerParams& p
     tf::graph g;
     FrontEnd front(g, run, source, limit, params.lk.levels, params.lk.sigma);
 
-    // A frame after the background refresh and the global treatment.
-    struct SeenMsg {
-      long long seq = 0;
-      FrameMsg frame;
-      std::shared_ptr<const stages::Foreground> fg;
-      std::shared_ptr<const std::vector<stages::Detection>> detections;
-    };
-    // The decisions at frame t, with what the plan of t+1 needs of frame t.
-    struct DecidedMsg {
-      long long seq = -1;
-      std::shared_ptr<const stages::TrackSet> state;
-      std::shared_ptr<const flow::Pyramid> pyramid;
-      std::shared_ptr<const stages::Foreground> fg;
-    };
-    // One frame's work between plan and decision.
-    struct FrameWork {
-      SeenMsg now;
-      DecidedMsg before;
-      std::vector<stages::ObjectTile> tiles;
-      Clock::time_point planned;
-    };
-    struct TileMsg {
-      std::shared_ptr<const FrameWork> work;
-      std::size_t tile = 0;
-    };
-    // To the collector: a tile's motion, or (tile < 0) a frame without tiles.
-    struct CollectMsg {
-      std::shared_ptr<const FrameWork> work;
-      long long tile = -1;
-      stages::TileMotion motion;
-    };
-    struct CollectedMsg {
-      std::shared_ptr<const FrameWork> work;
-      std::vector<stages::TileMotion> motions;
-    };
-
     // Background refresh: serial, in frame order (the model learns the frames in order).
     stages::MotionDetector detector(params.detector);
     tf::function_node<FrameMsg, SeenMsg> background(g, tf::serial, [&](const FrameMsg& m) {
@@ -583,49 +537,25 @@ RunReport run_mot(const FrameSource& source, const stages::MultiTrackerParams& p
         std::get<0>(ports).try_put(TileMsg{shared, i});
     });
 
-    // LK refinement over ROI tiles: one task per tile, a frame's tiles at once. Each task
-    // borrows a DenseLK (its workspace stays warm) from a free list.
-    std::mutex lk_mutex;
-    std::vector<std::unique_ptr<flow::DenseLK>> lk_free;
+    // LK refinement over ROI tiles: one task per tile, a frame's tiles at once.
+    LkPool lk_pool(params.lk);
     tf::function_node<TileMsg, CollectMsg> lk_tiles(g, tf::unlimited, [&](const TileMsg& m) {
       run.enter(Stage::Flow, m.work->now.seq);
       const auto t0 = Clock::now();
-      std::unique_ptr<flow::DenseLK> lk;
-      {
-        const std::lock_guard<std::mutex> lock(lk_mutex);
-        if (!lk_free.empty()) {
-          lk = std::move(lk_free.back());
-          lk_free.pop_back();
-        }
-      }
-      if (!lk) lk = std::make_unique<flow::DenseLK>(params.lk);
+      std::unique_ptr<flow::DenseLK> lk = lk_pool.take();
       CollectMsg out{m.work, static_cast<long long>(m.tile), {}};
       out.motion =
           stages::measure_tile(m.work->tiles[m.tile], *m.work->before.pyramid,
                                *m.work->now.frame.pyramid, *m.work->before.fg, *lk, params);
-      {
-        const std::lock_guard<std::mutex> lock(lk_mutex);
-        lk_free.push_back(std::move(lk));
-      }
+      lk_pool.give_back(std::move(lk));
       run.time("lk", t0);
       return out;
     });
 
-    // Joins a frame's tiles (they finish in any order) before its decision.
-    struct Pending {
-      std::shared_ptr<const FrameWork> work;
-      std::vector<stages::TileMotion> motions;
-    };
-    std::unordered_map<const FrameWork*, Pending> pending;  // the serial collector's only
+    TileCollector collector;  // joins a frame's tiles (they finish in any order)
     using CollectNode = tf::multifunction_node<CollectMsg, std::tuple<CollectedMsg>>;
     CollectNode collect(g, tf::serial, [&](const CollectMsg& m, auto& ports) {
-      Pending& p = pending[m.work.get()];
-      p.work = m.work;
-      if (m.tile >= 0) p.motions.push_back(m.motion);
-      if (p.motions.size() == m.work->tiles.size()) {
-        std::get<0>(ports).try_put(CollectedMsg{m.work, std::move(p.motions)});
-        pending.erase(m.work.get());
-      }
+      if (std::optional<CollectedMsg> done = collector.add(m)) std::get<0>(ports).try_put(*done);
     });
 
     using DecideNode =
@@ -634,20 +564,7 @@ RunReport run_mot(const FrameSource& source, const stages::MultiTrackerParams& p
       const SeenMsg& now = m.work->now;
       run.enter(Stage::Track, now.seq);
       const auto t0 = Clock::now();
-      bool global_frame = false;
-      auto state = std::make_shared<const stages::TrackSet>(stages::decide(
-          *m.work->before.state, now.frame.frame->index, now.frame.frame->gray.size(), m.motions,
-          *now.fg, *now.detections, params, &global_frame));
-      auto out =
-          std::make_shared<stages::MotFrame>(stages::report_frame(*state, m.motions, global_frame));
-      for (stages::TrackedObject& o : out->objects) {
-        for (const stages::TileMotion& tm : m.motions) {
-          const std::size_t ti = tm.track;
-          if (ti < m.work->before.state->tracks.size() &&
-              m.work->before.state->tracks[ti].id == o.id)
-            o.region |= tm.region;
-        }
-      }
+      auto [state, out] = decide_frame(m, params);
       run.time("decide", t0);
       out->ms = ms_since(m.work->planned);
       std::get<0>(ports).try_put(DecidedMsg{now.seq, state, now.frame.pyramid, now.fg});

@@ -29,14 +29,14 @@ report::ObjectsAnnotation annotation(const stages::MotFrame& f) {
   a.born = f.born;
   a.ended = f.ended;
   a.global = f.global;
-  for (const stages::TrackedObject& o : f.objects)
+  for (const stages::MotObject& o : f.objects)
     a.objects.push_back({o.id, o.box, o.velocity, o.lost, o.region});
   return a;
 }
 
 }  // namespace
 
-eval::MotBox mot_box(long long index, const stages::TrackedObject& o) {
+eval::MotBox mot_box(long long index, const stages::MotObject& o) {
   eval::MotBox b;
   b.frame = static_cast<int>(index + 1);
   b.id = static_cast<int>(o.id);
@@ -61,7 +61,7 @@ MotRun track_objects(const FrameSource& source, cv::Size size, double fps,
   std::vector<MotSink> sinks;
   sinks.push_back({"log", [&](const MotTrackedFrame& f) {
                      long long found = 0;
-                     for (const stages::TrackedObject& o : f.output->objects) {
+                     for (const stages::MotObject& o : f.output->objects) {
                        if (o.lost) {
                          ++lost_records;
                        } else {

@@ -70,6 +70,6 @@ std::string objects_summary_text(const std::string& what, const nlohmann::ordere
 
 // An object of frame `index` (0-based) as a MOTChallenge box: frame index + 1, the top-left
 // corner plus one (MOTChallenge counts pixels from 1), confidence 1 (eval::write_mot writes it).
-eval::MotBox mot_box(long long index, const stages::TrackedObject& object);
+eval::MotBox mot_box(long long index, const stages::MotObject& object);
 
 }  // namespace roiflow::pipeline

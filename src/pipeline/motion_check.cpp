@@ -33,14 +33,20 @@ MotionCheck check_motion(const FrameSource& video, const std::vector<eval::Track
   stages::MotionDetector detector(params.detector);
   while (std::optional<stages::Frame> f = video()) {
     ++c.frames;
-    const stages::Foreground fg = detector.observe(f->picture());
+    const cv::Mat picture = f->picture();
+    const cv::Rect2f view(0.f, 0.f, static_cast<float>(picture.cols),
+                          static_cast<float>(picture.rows));
+    const stages::Foreground fg = detector.observe(picture);
     const long long frame = c.frames;  // 1-based, as the log counts
     std::set<long long> bad_now;
     const auto it = by_frame.find(frame);
     if (it != by_frame.end()) {
       for (const eval::TrackRecord* r : it->second) {
         ++c.records;
-        const bool small = r->box.width < params.min_side || r->box.height < params.min_side;
+        // Collapsed, or hugging the border with the object outside the view: too little of the
+        // box lies in the frame.
+        const cv::Rect2f inside = r->box & view;
+        const bool small = inside.width < params.min_side || inside.height < params.min_side;
         // The model's first frames see everything as moving or nothing: not judged.
         const bool still =
             fg.observed > params.detector.warmup && fg.moving_share(r->box) <= params.still_share;

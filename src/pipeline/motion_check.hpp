@@ -9,9 +9,9 @@
 // The video is played through a background model of its own (stages::MotionDetector, the
 // tracker's defaults), independent of the tracker's. For each object, the check counts runs of
 // consecutive frames where the log reports it found (local and not lost) while its box holds
-// almost no moving pixels (share at most `still_share`) or has a side under `min_side`
-// pixels. A run longer than `max_run` frames is a violation: a box sitting on empty background,
-// a collapsed box, or one hugging the border.
+// almost no moving pixels (share at most `still_share`) or its part inside the frame has a side
+// under `min_side` pixels. A run longer than `max_run` frames is a violation: a box sitting on
+// empty background, a collapsed box, or one hugging the border with the object outside the view.
 #pragma once
 
 #include <string>

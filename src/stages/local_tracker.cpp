@@ -99,6 +99,10 @@ const char* to_string(LostReason reason) {
       return "background";
     case LostReason::Searching:
       return "searching";
+    case LostReason::Collapsed:
+      return "collapsed";
+    case LostReason::Still:
+      return "still";
   }
   return "?";
 }

@@ -150,7 +150,9 @@ enum class LostReason {
   ScaleJump,   // the box grows or shrinks faster between two frames than any object does
   TooLarge,    // the box is (nearly) as large as the frame
   Background,  // the box moves with the background right after the target moved unlike it
-  Searching    // lost before, and not yet found again by appearance
+  Searching,   // lost before, and not yet found again by appearance
+  Collapsed,   // stages::Tracker: the box's part inside the frame is under min_side on a side
+  Still        // stages::Tracker: no moving pixels in the box for still_frames frames
 };
 const char* to_string(LostReason reason);
 

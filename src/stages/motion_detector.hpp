@@ -3,10 +3,10 @@
 //
 //   using namespace roiflow::stages;
 //   MotionDetector detector;                              // MOG2 on a half-size copy at 768x576
-//   while (auto f = source.next()) {
-//     Foreground fg = detector.observe(f->picture());     // background refresh: serial, in order
+//   for (const cv::Mat& picture : {bgr, bgr}) {           // the frames of a fixed camera
+//     Foreground fg = detector.observe(picture);          // background refresh: serial, in order
 //     std::vector<Detection> objects = detect_objects(fg, detector.params());  // stateless
-//     double moving = fg.moving_share({10, 20, 30, 60});  // share of moving pixels in a box
+//     if (fg.moving_share({10, 20, 30, 60}) > 0.5) objects.clear();  // moving share of a box
 //   }
 //
 // observe() updates OpenCV's MOG2 with a frame shrunk by the whole factor that brings it nearest

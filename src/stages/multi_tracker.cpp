@@ -346,16 +346,18 @@ TileMotion measure_tile(const ObjectTile& tile, const flow::Pyramid& pyr_t,
   return out;
 }
 
-TrackSet decide(const TrackSet& previous, long long index, cv::Size size,
-                const std::vector<TileMotion>& motions, const Foreground& fg,
-                const std::vector<Detection>& detections, const MultiTrackerParams& params,
-                bool* global_frame) {
-  TrackSet s = previous;
-  s.frame = index;
-  s.size = size;
-  const std::size_t n = s.tracks.size();
+namespace {
 
-  // LK's measurement per object: the median motion of its pixels that passed the check.
+// LK's measurement per object (the median motion of its pixels that passed the check), where it
+// agrees with the filter; after each filter's prediction. guess: where each object is now.
+struct LkMeasures {
+  std::vector<char> ok;
+  std::vector<cv::Rect2f> box, guess;
+};
+
+LkMeasures measure_lk(TrackSet& s, const std::vector<TileMotion>& motions,
+                      const MultiTrackerParams& params) {
+  const std::size_t n = s.tracks.size();
   std::vector<std::vector<float>> mx(n), my(n);
   std::vector<int> sampled(n, 0);
   for (const TileMotion& m : motions) {
@@ -366,13 +368,12 @@ TrackSet decide(const TrackSet& previous, long long index, cv::Size size,
       my[m.track].push_back(d.y);
     }
   }
-  std::vector<char> lk_ok(n, 0);
-  std::vector<cv::Rect2f> lk_box(n), guess(n);
+  LkMeasures lk{std::vector<char>(n, 0), std::vector<cv::Rect2f>(n), std::vector<cv::Rect2f>(n)};
   for (std::size_t i = 0; i < n; ++i) {
     Track& t = s.tracks[i];
     const cv::Rect2f before = t.box;
     t.filter.predict();
-    guess[i] = t.filter.box();
+    lk.guess[i] = t.filter.box();
     const std::size_t good = mx[i].size();
     // LK's motion must agree with the motion the filter predicts: where another object passes
     // in front, the pixels of the region follow that one (an object does not turn back at once).
@@ -381,20 +382,26 @@ TrackSet decide(const TrackSet& previous, long long index, cv::Size size,
     const bool agrees =
         good == 0 || t.age < 3 || std::hypot(median(mx[i]) - v.x, median(my[i]) - v.y) <= gate;
     if (good >= 4 && static_cast<double>(good) >= params.min_inliers * sampled[i] && agrees) {
-      lk_ok[i] = 1;
-      lk_box[i] = before + cv::Point2f(median(mx[i]), median(my[i]));
-      lk_box[i].width = guess[i].width;
-      lk_box[i].height = guess[i].height;
-      lk_box[i].x = before.x + before.width / 2 + median(mx[i]) - guess[i].width / 2;
-      lk_box[i].y = before.y + before.height / 2 + median(my[i]) - guess[i].height / 2;
-      guess[i] = lk_box[i];
+      lk.ok[i] = 1;
+      cv::Rect2f& b = lk.box[i];
+      b.width = lk.guess[i].width;
+      b.height = lk.guess[i].height;
+      b.x = before.x + before.width / 2 + median(mx[i]) - lk.guess[i].width / 2;
+      b.y = before.y + before.height / 2 + median(my[i]) - lk.guess[i].height / 2;
+      lk.guess[i] = b;
     }
   }
+  return lk;
+}
 
-  // Blobs over several objects (they walk together or cross): no detection for any of them;
-  // LK keeps them apart.
-  const std::size_t nd = detections.size();
-  std::vector<char> merged(nd, 0), in_merge(n, 0);
+// Blobs over several objects (they walk together or cross): no detection for any of them;
+// LK keeps them apart. merged: per detection; in_merge: per object.
+void find_merges(const TrackSet& s, const std::vector<cv::Rect2f>& guess,
+                 const std::vector<Detection>& detections, const MultiTrackerParams& params,
+                 std::vector<char>& merged, std::vector<char>& in_merge) {
+  const std::size_t n = s.tracks.size(), nd = detections.size();
+  merged.assign(nd, 0);
+  in_merge.assign(n, 0);
   for (std::size_t j = 0; j < nd; ++j) {
     const cv::Rect2f& d = detections[j].box;
     std::vector<std::size_t> inside;
@@ -410,8 +417,16 @@ TrackSet decide(const TrackSet& previous, long long index, cv::Size size,
         in_merge[i] = 1;
     }
   }
+}
 
-  // Optimal assignment of the other detections to the other objects.
+// Optimal assignment of the detections outside merges to the objects outside merges: per
+// object, its detection or -1.
+std::vector<int> assign_detections(const TrackSet& s, const std::vector<cv::Rect2f>& guess,
+                                   const std::vector<Detection>& detections,
+                                   const std::vector<char>& merged,
+                                   const std::vector<char>& in_merge,
+                                   const MultiTrackerParams& params) {
+  const std::size_t n = s.tracks.size(), nd = detections.size();
   std::vector<std::size_t> rows, cols;
   for (std::size_t i = 0; i < n; ++i)
     if (!in_merge[i]) rows.push_back(i);
@@ -433,19 +448,21 @@ TrackSet decide(const TrackSet& previous, long long index, cv::Size size,
   }
   const Assignment assigned =
       solve_assignment(cost, static_cast<int>(rows.size()), static_cast<int>(cols.size()));
-  const std::vector<int>& match = assigned.row_to_col;
   std::vector<int> det_of(n, -1);
-  std::vector<char> det_used(nd, 0);
   for (std::size_t r = 0; r < rows.size(); ++r) {
-    if (match[r] < 0) continue;
-    const std::size_t j = cols[static_cast<std::size_t>(match[r])];
-    det_of[rows[r]] = static_cast<int>(j);
-    det_used[j] = 1;
+    if (assigned.row_to_col[r] < 0) continue;
+    det_of[rows[r]] = static_cast<int>(cols[static_cast<std::size_t>(assigned.row_to_col[r])]);
   }
+  return det_of;
+}
 
+// Each object's filter corrected by its detection, else by LK where its box holds moving
+// pixels; coasting otherwise. Returns whether a confirmed object is lost.
+bool correct_tracks(TrackSet& s, bool first, const LkMeasures& lk, const std::vector<int>& det_of,
+                    const Foreground& fg, const std::vector<Detection>& detections,
+                    const MultiTrackerParams& params) {
   bool any_lost = false;
-  const bool first = previous.frame < 0;
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = 0; i < s.tracks.size(); ++i) {
     Track& t = s.tracks[i];
     ++t.age;
     bool measured = false;
@@ -457,8 +474,8 @@ TrackSet decide(const TrackSet& previous, long long index, cv::Size size,
       ++t.hits;
     } else {
       if (t.id == 0) t.hits = -1;  // a tentative object must be seen in consecutive frames
-      if (lk_ok[i] && (t.known || fg.moving_share(lk_box[i]) >= params.min_moving)) {
-        t.filter.correct_centre((lk_box[i].tl() + lk_box[i].br()) * 0.5f, lk_box[i].height);
+      if (lk.ok[i] && (t.known || fg.moving_share(lk.box[i]) >= params.min_moving)) {
+        t.filter.correct_centre((lk.box[i].tl() + lk.box[i].br()) * 0.5f, lk.box[i].height);
         measured = true;
       }
     }
@@ -471,8 +488,12 @@ TrackSet decide(const TrackSet& previous, long long index, cv::Size size,
     t.still = fg.empty() || fg.moving_share(t.box) >= params.min_moving ? 0 : t.still + 1;
     if (t.id != 0 && t.lost > 0) any_lost = true;
   }
+  return any_lost;
+}
 
-  // Duplicates: two objects on one box for 3 frames -> the younger ends.
+// Duplicates (two objects on one box for 3 frames: the younger ends), deaths and confirmations.
+void end_and_confirm(TrackSet& s, cv::Size size, const MultiTrackerParams& params) {
+  const std::size_t n = s.tracks.size();
   for (std::size_t i = 0; i < n; ++i) {
     bool dup = false;
     for (std::size_t j = 0; j < n; ++j) {
@@ -483,8 +504,6 @@ TrackSet decide(const TrackSet& previous, long long index, cv::Size size,
     }
     s.tracks[i].duplicate = dup ? s.tracks[i].duplicate + 1 : 0;
   }
-
-  // Deaths and confirmations.
   std::vector<Track> kept;
   kept.reserve(n);
   for (Track& t : s.tracks) {
@@ -505,30 +524,56 @@ TrackSet decide(const TrackSet& previous, long long index, cv::Size size,
     kept.push_back(t);
   }
   s.tracks = std::move(kept);
+}
 
+// Births: detections no object explains start tentative objects.
+void add_births(TrackSet& s, const std::vector<Detection>& detections,
+                const std::vector<char>& used, const MultiTrackerParams& params) {
+  for (std::size_t j = 0; j < detections.size(); ++j) {
+    if (used[j]) continue;
+    const cv::Rect2f& d = detections[j].box;
+    bool explained = false;
+    for (const Track& t : s.tracks) {
+      if (iou(t.box, d) > 0.3 || (t.box & d).area() >= 0.5 * d.area()) explained = true;
+    }
+    if (explained) continue;
+    Track t;
+    t.box = d;
+    t.filter = BoxFilter::start(d);
+    t.hits = 1;
+    if (params.min_hits <= 1) {
+      t.id = s.next_id++;
+      ++s.born;
+    }
+    s.tracks.push_back(t);
+  }
+}
+
+}  // namespace
+
+TrackSet decide(const TrackSet& previous, long long index, cv::Size size,
+                const std::vector<TileMotion>& motions, const Foreground& fg,
+                const std::vector<Detection>& detections, const MultiTrackerParams& params,
+                bool* global_frame) {
+  TrackSet s = previous;
+  s.frame = index;
+  s.size = size;
+  const LkMeasures lk = measure_lk(s, motions, params);
+  std::vector<char> merged, in_merge;
+  find_merges(s, lk.guess, detections, params, merged, in_merge);
+  const std::vector<int> det_of =
+      assign_detections(s, lk.guess, detections, merged, in_merge, params);
+  std::vector<char> used = merged;  // detections that start no object
+  for (int j : det_of)
+    if (j >= 0) used[static_cast<std::size_t>(j)] = 1;
+  const bool any_lost = correct_tracks(s, previous.frame < 0, lk, det_of, fg, detections, params);
+  end_and_confirm(s, size, params);
   // Births on global frames: detections no object explains.
   const bool global =
       params.births && ((index % params.global_interval) == 0 || any_lost || s.tracks.empty());
   if (global) {
     ++s.global_activations;
-    for (std::size_t j = 0; j < nd; ++j) {
-      if (det_used[j] || merged[j]) continue;
-      const cv::Rect2f& d = detections[j].box;
-      bool explained = false;
-      for (const Track& t : s.tracks) {
-        if (iou(t.box, d) > 0.3 || (t.box & d).area() >= 0.5 * d.area()) explained = true;
-      }
-      if (explained) continue;
-      Track t;
-      t.box = d;
-      t.filter = BoxFilter::start(d);
-      t.hits = 1;
-      if (params.min_hits <= 1) {
-        t.id = s.next_id++;
-        ++s.born;
-      }
-      s.tracks.push_back(t);
-    }
+    add_births(s, detections, used, params);
   }
   if (global_frame != nullptr) *global_frame = global;
   return s;
@@ -544,7 +589,7 @@ MotFrame report_frame(const TrackSet& state, const std::vector<TileMotion>& moti
   f.global_activations = state.global_activations;
   for (const Track& t : state.tracks) {
     if (t.id == 0) continue;
-    TrackedObject o;
+    MotObject o;
     o.id = t.id;
     o.box = t.box;
     o.velocity = t.filter.velocity();

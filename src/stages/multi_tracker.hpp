@@ -1,10 +1,12 @@
 // MultiTracker: every moving object of a fixed camera, each followed by LK in its own region.
 //
+//   #include <iostream>
 //   using namespace roiflow;
 //   stages::MultiTracker tracker;                          // fixed camera, nothing known
-//   while (auto f = source.next()) {
-//     stages::MotFrame out = tracker.process(f->index, f->gray, f->picture());
-//     for (const stages::TrackedObject& o : out.objects)
+//   long long index = 0;
+//   for (const cv::Mat& gray : {frame_t, frame_t1}) {     // the frames of a fixed camera
+//     stages::MotFrame out = tracker.process(index++, gray, bgr);  // gray and colour picture
+//     for (const stages::MotObject& o : out.objects)
 //       if (!o.lost) std::cout << o.id << " " << o.box << "\n";
 //   }
 //
@@ -136,7 +138,7 @@ struct TileMotion {
   cv::Rect region;  // where forward LK ran
 };
 
-struct TrackedObject {
+struct MotObject {
   long long id = 0;
   cv::Rect2f box;
   cv::Point2f velocity;
@@ -147,7 +149,7 @@ struct TrackedObject {
 // One decided frame, as the sinks see it.
 struct MotFrame {
   long long index = 0;
-  std::vector<TrackedObject> objects;                     // confirmed objects, lost ones flagged
+  std::vector<MotObject> objects;                     // confirmed objects, lost ones flagged
   bool global = false;                                    // births were searched on this frame
   long long born = 0, ended = 0, global_activations = 0;  // running totals
   double ms = 0;                                          // tracker time of this frame

@@ -159,6 +159,16 @@ void TrackerParams::validate() const {
   if (!(held_learning > 0 && held_learning <= 1)) {
     throw Error("tracker: held_learning must be in (0, 1], got " + number_text(held_learning));
   }
+  if (!(min_side >= 0 && min_side <= 1000)) {
+    throw Error("tracker: min_side must be in [0, 1000], got " + number_text(min_side));
+  }
+  if (still_frames < 0 || still_frames > 100000) {
+    throw Error("tracker: still_frames must be in 0..100000, got " + std::to_string(still_frames));
+  }
+  if (!(still_level >= 0 && still_level <= 255) || !(still_share >= 0 && still_share <= 1)) {
+    throw Error("tracker: still_level must be in [0, 255] and still_share in [0, 1], got " +
+                number_text(still_level) + " and " + number_text(still_share));
+  }
   detector.validate();
 }
 
@@ -183,6 +193,8 @@ struct Tracker::Impl {
   bool camera_moves = false;
   cv::Rect2f last_held;       // the target's box the last time the local treatment held it
   long long frames_lost = 0;  // frames lost in a row
+  long long still_run = 0;    // frames in a row the held box held no moving pixels
+  float start_side = 0;       // the shorter side of the box the target was started from
   long long activations = 0;
   long long observed_index = -1;  // the last frame given to the background model
 
@@ -226,6 +238,7 @@ struct Tracker::Impl {
   TrackerOutput process(const TrackerInput& frame);
   void acquire(const TrackerInput& frame, TrackerOutput& out);
   void follow(const TrackerInput& frame, TrackerOutput& out, double refresh_weight);
+  LostReason self_check(const TrackerInput& frame, const cv::Rect2f& box);
 
   // The background model is only needed to find a target that was not given. `weight`: the
   // frames of video this observation stands for. `beside`: as a job of the executor, beside the
@@ -260,6 +273,7 @@ void Tracker::Impl::acquire(const TrackerInput& frame, TrackerOutput& out) {
     detector.set_target(image, b);
     local.start({frame.gray, frame.pyramid}, b);
     last_held = b;
+    start_side = std::min(inside.width, inside.height);
     if (params.mode == TrackMode::Global) ++activations;
     out.mode =
         params.mode == TrackMode::Global ? TrackRecord::Mode::Global : TrackRecord::Mode::Local;
@@ -279,10 +293,34 @@ void Tracker::Impl::acquire(const TrackerInput& frame, TrackerOutput& out) {
     detector.set_target(image, box);
     local.start({frame.gray, frame.pyramid}, box);
     last_held = box;
+    start_side = std::min(box.width, box.height);
     out.box = box;
   }
   has_target = true;
   out.has_target = true;
+}
+
+// Why a box the local treatment holds is no tracked object (Found: it is one): too little of
+// it lies in the frame, or (a target found by its motion) it held no moving pixels for
+// still_frames frames.
+LostReason Tracker::Impl::self_check(const TrackerInput& frame, const cv::Rect2f& box) {
+  const cv::Rect2f frame_box(0.f, 0.f, static_cast<float>(size.width),
+                             static_cast<float>(size.height));
+  const cv::Rect2f inside = box & frame_box;
+  // A target started smaller than twice min_side collapses at half its start size.
+  const float min_side = std::min(static_cast<float>(params.min_side), start_side / 2);
+  if (inside.width < min_side || inside.height < min_side) return LostReason::Collapsed;
+  if (params.init || params.still_frames == 0 || previous_gray.empty() || camera_moves) {
+    still_run = 0;
+    return LostReason::Found;
+  }
+  const cv::Rect r = cv::Rect(inside) & cv::Rect(cv::Point(), size);
+  if (r.empty()) return LostReason::Collapsed;
+  cv::Mat diff;
+  cv::absdiff(frame.gray(r), previous_gray(r), diff);
+  const double moving = cv::countNonZero(diff > params.still_level);
+  still_run = moving <= params.still_share * r.area() ? still_run + 1 : 0;
+  return still_run >= params.still_frames ? LostReason::Still : LostReason::Found;
 }
 
 void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double refresh_weight) {
@@ -300,7 +338,9 @@ void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double
     if (bg >= 0) camera_moves = bg > params.camera_motion;
   }
   out.reason = r.reason;
-  if (!r.lost) {
+  const LostReason self = r.lost ? r.reason : self_check(frame, r.box);
+  if (self != r.reason) out.reason = self;
+  if (self == LostReason::Found) {
     lost = false;
     frames_lost = 0;
     last_held = r.box;
@@ -345,6 +385,7 @@ void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double
   }
   if (accept) {
     local.restart({frame.gray, frame.pyramid}, found->box);
+    still_run = 0;
     out.reason = LostReason::Found;
     lost = false;
     out.box = found->box;

@@ -90,6 +90,17 @@ struct TrackerParams {
   double reach_growth = 0.05;
   // While the target stays lost, the whole-frame search runs every this many frames, 1..1000.
   int redetect_interval = 1;
+  // A held box whose part inside the frame is narrower or lower than this is lost (a box that
+  // collapsed, or hugs the border with the object outside the view), pixels, [0, 1000].
+  double min_side = 8;
+  // Without `init` (the target was found by its motion): a held box is lost once it has held no
+  // moving pixels for this many frames in a row (0 = never). A pixel moves when it changes by
+  // more than still_level grey levels from the previous frame; a box with at most still_share of
+  // its pixels moving holds none. A camera that moves makes every box move: the rule is a guard
+  // for fixed cameras. still_frames 0..100000, still_level [0, 255], still_share [0, 1].
+  int still_frames = 20;
+  double still_level = 25;
+  double still_share = 0.02;
   GlobalDetectorParams detector;
   void validate() const;  // throws roiflow::Error naming the bad value
 };

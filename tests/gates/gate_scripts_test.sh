@@ -33,7 +33,9 @@ cat >"$work/stub/roiflow" <<STUB
 #!/usr/bin/env bash
 if [[ \$1 == eval ]]; then cat "$work/eval_\$(basename "\$2").csv"; exit 0; fi
 if [[ \$1 == motion-check ]]; then
-  cat "$work/motion_\$(basename "\$2").json"
+  log="$work/motion_\$(basename "\$3" .csv).json"  # a log's own answer, else its video's
+  [[ -f \$log ]] || log="$work/motion_\$(basename "\$2").json"
+  cat "\$log"
   exit "\$(cat "$work/motion.rc")"
 fi
 if [[ \$1 == track ]]; then
@@ -160,6 +162,12 @@ expect fail "mot gate, an object found on empty background for 45 frames" mgate
 motion_json opencv_vtest.avi 795 45 0
 expect fail "mot gate, a 45-frame run even with exit 0" mgate
 motion_json opencv_vtest.avi 795 3 0
+motion_json highway_single 748 379 0
+expect fail "mot gate, the --single run on the highway holds a collapsed box for 379 frames" mgate
+rm "$work/motion_highway_single.json"
+motion_json vtest_single 795 nan 0
+expect fail "mot gate, the --single run's longest run nan" mgate
+rm "$work/motion_vtest_single.json"
 head -n 700 "$mgt" >"$work/gt_short.txt" && cp "$mgt" "$work/gt_full.txt" && cp "$work/gt_short.txt" "$mgt"
 expect fail "mot gate, ground truth of 700 frames" mgate
 cp "$work/gt_full.txt" "$mgt"

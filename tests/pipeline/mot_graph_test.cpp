@@ -47,7 +47,7 @@ MotScene busy_scene(int count) {
   return MotScene({640, 200 + 90 * ((count - 1) / 8)}, objects);
 }
 
-using Frames = std::vector<std::vector<stages::TrackedObject>>;
+using Frames = std::vector<std::vector<stages::MotObject>>;
 
 Frames serial(const MotScene& scene, int frames, const stages::MultiTrackerParams& p) {
   stages::MultiTracker tracker(p);

@@ -124,7 +124,7 @@ std::vector<std::map<long long, cv::Rect2f>> run(const MotScene& scene, int fram
     cv::cvtColor(bgr, gray, cv::COLOR_BGR2GRAY);
     const MotFrame f = tracker.process(t, gray, bgr);
     std::map<long long, cv::Rect2f> found;
-    for (const stages::TrackedObject& o : f.objects)
+    for (const stages::MotObject& o : f.objects)
       if (!o.lost) found[o.id] = o.box;
     out.push_back(found);
     if (last != nullptr) *last = f;

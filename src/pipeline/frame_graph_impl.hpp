@@ -1,0 +1,134 @@
+// Internal to frame_graph.cpp: the message a decoded frame travels in, and the multi-object
+// graph's messages and helpers (run_mot: plan -> LK tiles -> collect -> decision).
+#pragma once
+
+#include <chrono>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "flow/dense_lk.hpp"
+#include "flow/pyramid.hpp"
+#include "stages/motion_detector.hpp"
+#include "stages/multi_tracker.hpp"
+#include "stages/video_source.hpp"
+
+namespace roiflow::pipeline::frame_graph_impl {
+
+using Clock = std::chrono::steady_clock;
+
+inline double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// A decoded frame on its way through the pyramid levels.
+struct FrameMsg {
+  long long seq = 0;
+  std::shared_ptr<const stages::Frame> frame;
+  std::shared_ptr<flow::Pyramid> pyramid;  // filled level by level, then only read
+};
+
+// A frame after the background refresh and the global treatment.
+struct SeenMsg {
+  long long seq = 0;
+  FrameMsg frame;
+  std::shared_ptr<const stages::Foreground> fg;
+  std::shared_ptr<const std::vector<stages::Detection>> detections;
+};
+// The decisions at frame t, with what the plan of t+1 needs of frame t.
+struct DecidedMsg {
+  long long seq = -1;
+  std::shared_ptr<const stages::TrackSet> state;
+  std::shared_ptr<const flow::Pyramid> pyramid;
+  std::shared_ptr<const stages::Foreground> fg;
+};
+// One frame's work between plan and decision.
+struct FrameWork {
+  SeenMsg now;
+  DecidedMsg before;
+  std::vector<stages::ObjectTile> tiles;
+  Clock::time_point planned;
+};
+struct TileMsg {
+  std::shared_ptr<const FrameWork> work;
+  std::size_t tile = 0;
+};
+// To the collector: a tile's motion, or (tile < 0) a frame without tiles.
+struct CollectMsg {
+  std::shared_ptr<const FrameWork> work;
+  long long tile = -1;
+  stages::TileMotion motion;
+};
+struct CollectedMsg {
+  std::shared_ptr<const FrameWork> work;
+  std::vector<stages::TileMotion> motions;
+};
+
+// Joins a frame's tile motions, which finish in any order: add() returns the frame's motions
+// once its last tile (or its header, for a frame without tiles) came in. Serial use only.
+class TileCollector {
+ public:
+  std::optional<CollectedMsg> add(const CollectMsg& m) {
+    std::vector<stages::TileMotion>& motions = pending_[m.work.get()];
+    if (m.tile >= 0) motions.push_back(m.motion);
+    if (motions.size() != m.work->tiles.size()) return std::nullopt;
+    CollectedMsg done{m.work, std::move(motions)};
+    pending_.erase(m.work.get());
+    return done;
+  }
+
+ private:
+  std::unordered_map<const FrameWork*, std::vector<stages::TileMotion>> pending_;
+};
+
+// The DenseLK workspaces of the LK tile tasks: each task borrows one (it stays warm).
+class LkPool {
+ public:
+  explicit LkPool(const flow::LkParams& params) : params_(params) {}
+  std::unique_ptr<flow::DenseLK> take() {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      if (!free_.empty()) {
+        std::unique_ptr<flow::DenseLK> lk = std::move(free_.back());
+        free_.pop_back();
+        return lk;
+      }
+    }
+    return std::make_unique<flow::DenseLK>(params_);
+  }
+  void give_back(std::unique_ptr<flow::DenseLK> lk) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    free_.push_back(std::move(lk));
+  }
+
+ private:
+  flow::LkParams params_;
+  std::mutex mutex_;
+  std::vector<std::unique_ptr<flow::DenseLK>> free_;
+};
+
+// The decision at a frame from its tiles' motions: the new state and what the sinks see (each
+// object's region is the union of its tiles').
+inline std::pair<std::shared_ptr<const stages::TrackSet>, std::shared_ptr<stages::MotFrame>>
+decide_frame(const CollectedMsg& m, const stages::MultiTrackerParams& params) {
+  const SeenMsg& now = m.work->now;
+  bool global_frame = false;
+  auto state = std::make_shared<const stages::TrackSet>(
+      stages::decide(*m.work->before.state, now.frame.frame->index, now.frame.frame->gray.size(),
+                     m.motions, *now.fg, *now.detections, params, &global_frame));
+  auto out =
+      std::make_shared<stages::MotFrame>(stages::report_frame(*state, m.motions, global_frame));
+  for (stages::MotObject& o : out->objects) {
+    for (const stages::TileMotion& tm : m.motions) {
+      const std::size_t ti = tm.track;
+      if (ti < m.work->before.state->tracks.size() && m.work->before.state->tracks[ti].id == o.id)
+        o.region |= tm.region;
+    }
+  }
+  return {state, out};
+}
+
+}  // namespace roiflow::pipeline::frame_graph_impl
