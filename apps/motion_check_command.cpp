@@ -5,7 +5,6 @@
 //   roiflow motion-check ../shared/data/video/opencv_vtest.avi out/track.csv --format json
 #include <CLI/CLI.hpp>
 #include <iostream>
-#include <nlohmann/json.hpp>
 #include <string>
 
 #include "cli_common.hpp"
@@ -41,24 +40,8 @@ void add_motion_check_command(CLI::App& app, int& exit_code) {
     stages::VideoSource video(cmd.video);
     const pipeline::MotionCheck c =
         pipeline::check_motion([&] { return video.next(); }, log, cmd.params);
-    nlohmann::ordered_json violations = nlohmann::json::array();
-    for (const pipeline::MotionViolation& v : c.violations)
-      violations.push_back({{"id", v.id}, {"first", v.first}, {"last", v.last}, {"what", v.what}});
-    if (cmd.format == "json") {
-      const nlohmann::ordered_json doc = {{"frames", c.frames},      {"objects", c.objects},
-                                          {"records", c.records},    {"still", c.still},
-                                          {"small", c.small},        {"longest_run", c.longest},
-                                          {"violations", violations}};
-      std::cout << doc.dump(2) << "\n";
-    } else {
-      std::cout << "frames " << c.frames << ", objects " << c.objects << ", found records "
-                << c.records << ": without moving pixels " << c.still << ", collapsed " << c.small
-                << ", longest run " << c.longest << " frames (allowed " << cmd.params.max_run
-                << ")\n";
-      for (const pipeline::MotionViolation& v : c.violations)
-        std::cout << "  id " << v.id << " frames " << v.first << "-" << v.last << ": " << v.what
-                  << "\n";
-    }
+    std::cout << (cmd.format == "json" ? pipeline::to_json(c).dump(2) + "\n"
+                                       : pipeline::motion_check_text(c, cmd.params.max_run));
     exit_code = c.violations.empty() ? 0 : 1;
   });
 }

@@ -1,5 +1,7 @@
 #include "pipeline/motion_check.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <map>
 #include <set>
@@ -71,6 +73,25 @@ MotionCheck check_motion(const FrameSource& video, const std::vector<eval::Track
   for (long long id : rest)
     close(id);
   return c;
+}
+
+nlohmann::ordered_json to_json(const MotionCheck& c) {
+  nlohmann::ordered_json violations = nlohmann::json::array();
+  for (const MotionViolation& v : c.violations)
+    violations.push_back({{"id", v.id}, {"first", v.first}, {"last", v.last}, {"what", v.what}});
+  return {{"frames", c.frames},      {"objects", c.objects}, {"records", c.records},
+          {"still", c.still},        {"small", c.small},     {"longest_run", c.longest},
+          {"violations", violations}};
+}
+
+std::string motion_check_text(const MotionCheck& c, long long max_run) {
+  std::string text = fmt::format(
+      "frames {}, objects {}, found records {}: without moving pixels {}, collapsed {}, longest "
+      "run {} frames (allowed {})\n",
+      c.frames, c.objects, c.records, c.still, c.small, c.longest, max_run);
+  for (const MotionViolation& v : c.violations)
+    text += fmt::format("  id {} frames {}-{}: {}\n", v.id, v.first, v.last, v.what);
+  return text;
 }
 
 }  // namespace roiflow::pipeline

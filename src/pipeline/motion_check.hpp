@@ -14,6 +14,7 @@
 // empty background, a collapsed box, or one hugging the border with the object outside the view.
 #pragma once
 
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -48,5 +49,10 @@ struct MotionCheck {
 
 MotionCheck check_motion(const FrameSource& video, const std::vector<eval::TrackRecord>& log,
                          const MotionCheckParams& params = {});
+// {"frames", "objects", "records", "still", "small", "longest_run", "violations": [{"id",
+// "first", "last", "what"}]}
+nlohmann::ordered_json to_json(const MotionCheck& c);
+// One line of counts, then one line per violation; each ends in '\n'.
+std::string motion_check_text(const MotionCheck& c, long long max_run);
 
 }  // namespace roiflow::pipeline

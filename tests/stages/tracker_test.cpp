@@ -188,6 +188,65 @@ TEST(Tracker, WithoutInitTheMovingObjectIsDetectedThenTrackedLocally) {
   EXPECT_EQ(outs.back().global_activations, static_cast<long long>(found) + 2);
 }
 
+// An object found by its motion that stops: after still_frames frames without moving pixels in
+// its box it is no tracked object any more (lost), where without the rule it would be held on
+// the still picture for ever.
+TEST(Tracker, AnObjectFoundByItsMotionThatStopsIsLostAfterStillFrames) {
+  const eval::TrackingScene scene(small_scene(0.0));
+  for (const int still_frames : {20, 0}) {
+    TrackerParams params;
+    params.still_frames = still_frames;
+    Tracker tracker(params);
+    for (int i = 0; i < 15; ++i)
+      tracker.process(input(tracker, scene.render(i), i));
+    const cv::Mat stopped = scene.render(14);
+    int held = 0;  // frames held after the stop, in a row from it
+    bool lost = false;
+    for (int i = 15; i < 60 && !lost; ++i) {
+      const TrackerOutput o = tracker.process(input(tracker, stopped, i));
+      ASSERT_TRUE(o.has_target);
+      lost = o.lost;
+      if (!lost) ++held;
+      if (lost) {
+        EXPECT_EQ(o.reason, LostReason::Still);
+      }
+    }
+    if (still_frames > 0) {
+      EXPECT_TRUE(lost);
+      EXPECT_EQ(held, still_frames - 1);  // the stop's first frame still differs from the last
+    } else {
+      EXPECT_FALSE(lost);
+      EXPECT_EQ(held, 45);
+    }
+  }
+}
+
+// An object that leaves the view: no box reported held has less than min_side pixels of it in the
+// frame on a side.
+TEST(Tracker, ABoxHuggingTheBorderIsNeverReportedHeld) {
+  const eval::TrackingScene scene(small_scene(0.0));
+  TrackerParams params = with_init(scene);
+  Tracker tracker(params);
+  const cv::Rect2f view(0, 0, static_cast<float>(scene.size().width),
+                        static_cast<float>(scene.size().height));
+  bool lost = false;
+  for (int i = 0; i < 60; ++i) {
+    // From frame 5 the picture slides left 12 pixels a frame: the object leaves the view.
+    const float shift = i > 5 ? -12.f * static_cast<float>(i - 5) : 0.f;
+    const cv::Mat m = (cv::Mat_<double>(2, 3) << 1, 0, shift, 0, 1, 0);
+    cv::Mat frame;
+    cv::warpAffine(scene.render(i), frame, m, scene.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+                   cv::Scalar::all(128));
+    const TrackerOutput o = tracker.process(input(tracker, frame, i));
+    const cv::Rect2f inside = o.box & view;
+    if (!o.lost) {
+      EXPECT_GE(std::min(inside.width, inside.height), params.min_side) << "frame " << i;
+    }
+    lost = lost || o.lost;
+  }
+  EXPECT_TRUE(lost);
+}
+
 // The demo's scene seen by a camera that starts panning on frame `pan_from` (the picture moves
 // by `speed` pixels a frame to the left, borders replicated), and the truth moved alike.
 struct PanningScene {
