@@ -5,9 +5,9 @@
 //
 //   using namespace roiflow;
 //   stages::LocalTracker local;                              // paper defaults: ROI 50, LK 10/3/3
-//   local.start({frame_t}, {70, 51, 107, 87});               // appearance captured from frame t
-//   const stages::LocalResult r = local.track({frame_t1});   // frame t -> frame t+1
-//   if (r.lost) local.restart({frame_t1}, r.box);            // once the global treatment finds it
+//   local.start({frame_t, nullptr}, {70, 51, 107, 87});     // appearance captured from frame t
+//   const stages::LocalResult r = local.track({frame_t1, nullptr});  // frame t -> frame t+1
+//   if (r.lost) local.restart({frame_t1, nullptr}, r.box);  // where the global treatment found it
 //   std::cout << r.box << " moved " << r.velocity << " px\n";
 #pragma once
 

@@ -9,7 +9,7 @@
 //   stages::Tracker tracker(params);
 //   stages::VideoSource source("car.mp4");
 //   while (std::optional<stages::Frame> f = source.next()) {
-//     stages::TrackerInput in{f->index, f->image, f->gray};
+//     stages::TrackerInput in{f->index, f->image, f->gray, nullptr, f->deferred_image};
 //     if (tracker.wants_pyramid()) {                 // optional: a pyramid built outside
 //       in.pyramid = std::make_shared<flow::Pyramid>(
 //           flow::build_pyramid(f->gray, tracker.pyramid_levels(), tracker.pyramid_sigma()));
