@@ -18,10 +18,10 @@ struct BatchCommand {
 
 // The job's own command line, parsed like `roiflow track` / `roiflow dense` options.
 pipeline::BatchOptions job_options(const BatchCommand& cmd) {
-  const std::string kind = cmd.job.empty() ? "" : cmd.job[0];
+  if (cmd.job.empty()) throw UsageError("batch needs a job after '--': track or dense");
+  const std::string& kind = cmd.job[0];
   if (kind != "track" && kind != "dense") {
-    throw UsageError("batch: the job after '--' must be track or dense" +
-                     (kind.empty() ? std::string() : ", got '" + kind + "'"));
+    throw UsageError("batch: the job after '--' must be track or dense, got '" + kind + "'");
   }
   CLI::App app{"roiflow batch job", "roiflow batch -- " + kind};
   pipeline::BatchOptions o = cmd.run;

@@ -319,9 +319,9 @@ std::vector<BatchRow> run_batch(const std::vector<std::string>& videos,
       for (std::size_t i = next++; i < videos.size(); i = next++) {
         rows[i] = run_one(videos[i], out, names[i], options, executor);
         std::lock_guard<std::mutex> lock(report);
-        if (options.on_row) options.on_row(rows[i]);
         ended[i] = rows[i];
         if (!options.csv.empty()) write_batch_csv(options.csv, ended);
+        if (options.on_row) options.on_row(rows[i]);
       }
     });
   });

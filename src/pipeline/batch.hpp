@@ -67,7 +67,8 @@ struct BatchOptions {
   // batch.csv, kept current as videos end (the rows of the videos ended so far, in input order),
   // so a killed batch leaves the rows of what it finished; empty = none.
   std::string csv;
-  // Called (from the arena's threads, one call at a time) as each video ends or is skipped.
+  // Called (from the arena's threads, one call at a time) as each video ends or is skipped, after
+  // its row is in `csv`.
   std::function<void(const BatchRow&)> on_row;
 };
 

@@ -64,7 +64,7 @@ TEST_F(BatchRun, CsvFollowsTheVideosInInputOrder) {
   std::vector<std::string> seen;
   o.on_row = [&](const BatchRow& r) {
     seen.push_back(r.video);
-    // Each row is in batch.csv by the time the next video ends.
+    // Each row is in batch.csv when on_row announces it.
     EXPECT_NE(test::read_text(o.csv).find(r.video), std::string::npos);
   };
   const std::vector<std::string> videos = {path("b.avi"), path("a.avi")};
