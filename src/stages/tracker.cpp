@@ -383,9 +383,11 @@ void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double
         (1.5f + static_cast<float>(params.reach_growth) * static_cast<float>(frames_lost));
     accept = d.dot(d) <= reach * reach;
   }
-  if (accept) {
+  // A re-detection is held to the same self-checks as a held box.
+  const LostReason again = accept ? self_check(frame, found->box) : LostReason::Found;
+  if (again != LostReason::Found) out.reason = again;
+  if (accept && again == LostReason::Found) {
     local.restart({frame.gray, frame.pyramid}, found->box);
-    still_run = 0;
     out.reason = LostReason::Found;
     lost = false;
     out.box = found->box;

@@ -86,8 +86,8 @@ struct TrackerParams {
   // its pixels moving holds none. A camera that moves makes every box move: the rule is a guard
   // for fixed cameras. still_frames 0..100000, still_level [0, 255], still_share [0, 1].
   int still_frames = 20;
-  double still_level = 25;
-  double still_share = 0.02;
+  double still_level = 40;
+  double still_share = 0.05;
   GlobalDetectorParams detector;
   void validate() const;  // throws roiflow::Error naming the bad value
 };
