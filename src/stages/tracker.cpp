@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <string>
 #include <utility>
 #include <vector>
@@ -183,6 +184,10 @@ TrackRecord TrackerOutput::record() const {
   return r;
 }
 
+// self_check compares a box with the frame this many frames back: a slow object changes its
+// pixels more over a few frames than between two.
+constexpr std::size_t kStillBaseline = 4;
+
 struct Tracker::Impl {
   TrackerParams params;
   LocalTracker local;
@@ -214,6 +219,7 @@ struct Tracker::Impl {
   // The last frame's gray image, and its whole pyramid while the target is being acquired
   // (refine_by_motion needs both frames' whole pyramids; the local treatment builds its own).
   cv::Mat previous_gray;
+  std::deque<cv::Mat> recent_gray;  // the last frames' gray images, newest last (self_check)
   std::shared_ptr<const flow::Pyramid> previous;
   std::atomic<bool> wants_pyramid{true};
   // The background refresh running beside the frames while the target is held (it touches
@@ -310,14 +316,16 @@ LostReason Tracker::Impl::self_check(const TrackerInput& frame, const cv::Rect2f
   // A target started smaller than twice min_side collapses at half its start size.
   const float min_side = std::min(static_cast<float>(params.min_side), start_side / 2);
   if (inside.width < min_side || inside.height < min_side) return LostReason::Collapsed;
-  if (params.init || params.still_frames == 0 || previous_gray.empty() || camera_moves) {
+  if (params.init || params.still_frames == 0 || recent_gray.empty() || camera_moves) {
     still_run = 0;
     return LostReason::Found;
   }
   const cv::Rect r = cv::Rect(inside) & cv::Rect(cv::Point(), size);
   if (r.empty()) return LostReason::Collapsed;
   cv::Mat diff;
-  cv::absdiff(frame.gray(r), previous_gray(r), diff);
+  // Against the frame still_baseline frames back (the oldest kept when fewer have been seen).
+  const std::size_t back = std::min(recent_gray.size(), static_cast<std::size_t>(kStillBaseline));
+  cv::absdiff(frame.gray(r), recent_gray[recent_gray.size() - back](r), diff);
   const double moving = cv::countNonZero(diff > params.still_level);
   still_run = moving <= params.still_share * r.area() ? still_run + 1 : 0;
   return still_run >= params.still_frames ? LostReason::Still : LostReason::Found;
@@ -439,6 +447,8 @@ TrackerOutput Tracker::Impl::process(const TrackerInput& frame) {
     acquire(frame, out);
   }
   previous_gray = frame.gray;
+  recent_gray.push_back(frame.gray);
+  if (recent_gray.size() > kStillBaseline) recent_gray.pop_front();
   previous = has_target ? nullptr : frame.pyramid;
   wants_pyramid.store(params.mode == TrackMode::Global || !has_target, std::memory_order_relaxed);
   out.global_activations = activations;

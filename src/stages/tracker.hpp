@@ -81,12 +81,13 @@ struct TrackerParams {
   // collapsed, or hugs the border with the object outside the view), pixels, [0, 1000].
   double min_side = 8;
   // Without `init` (the target was found by its motion): a held box is lost once it has held no
-  // moving pixels for this many frames in a row (0 = never). A pixel moves when it changes by
-  // more than still_level grey levels from the previous frame; a box with at most still_share of
-  // its pixels moving holds none. A camera that moves makes every box move: the rule is a guard
-  // for fixed cameras. still_frames 0..100000, still_level [0, 255], still_share [0, 1].
-  int still_frames = 20;
-  double still_level = 40;
+  // moving pixels for this many frames in a row (0 = never). A pixel moves when it differs by
+  // more than still_level grey levels from the same pixel 4 frames back; a box with at most
+  // still_share of its pixels moving holds none. A camera that moves makes every box move: the
+  // rule is a guard for fixed cameras. still_frames 0..100000, still_level [0, 255], still_share
+  // [0, 1].
+  int still_frames = 15;
+  double still_level = 35;
   double still_share = 0.05;
   GlobalDetectorParams detector;
   void validate() const;  // throws roiflow::Error naming the bad value
