@@ -206,8 +206,8 @@ void flow_from_pyramids(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkPar
   for (int l = levels - 1; l >= 0; --l) {
     const cv::Rect& c = comp[l];
     if (l < plan.finest) {  // below the finest level the flow is only upsampled
-      upsample_flow(view(ws.u[l + 1], comp[l + 1].size()), comp[l + 1].tl(), c, ws.u[l]);
-      upsample_flow(view(ws.v[l + 1], comp[l + 1].size()), comp[l + 1].tl(), c, ws.v[l]);
+      upsample_flow(view(ws.u[l + 1], comp[l + 1].size()), comp[l + 1].tl(), c, ws.u[l], &exec);
+      upsample_flow(view(ws.v[l + 1], comp[l + 1].size()), comp[l + 1].tl(), c, ws.v[l], &exec);
       continue;
     }
     cv::Mat coarse_u, coarse_v;  // LevelInput points at these

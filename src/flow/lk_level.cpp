@@ -288,12 +288,20 @@ void iterate_level(const LevelProblem& p, const LevelInput& input, cv::Mat& u, c
   }
 }
 
-void upsample_flow(const cv::Mat& src, cv::Point src_origin, const cv::Rect& dst, cv::Mat& out) {
+void upsample_flow(const cv::Mat& src, cv::Point src_origin, const cv::Rect& dst, cv::Mat& out,
+                   const Executor* executor) {
   out.create(dst.size(), CV_32F);
   const LkKernels& k = lk_kernels();
-  std::vector<float> temp(upsample_temp_floats(src.cols));
-  for (int y = 0; y < dst.height; ++y)
-    upsample_row(k, src, src_origin, dst, y, temp.data(), out.ptr<float>(y));
+  auto rows = [&](int y0, int y1) {
+    std::vector<float> temp(upsample_temp_floats(src.cols));
+    for (int y = y0; y < y1; ++y)
+      upsample_row(k, src, src_origin, dst, y, temp.data(), out.ptr<float>(y));
+  };
+  if (executor && executor->concurrency() > 1) {
+    executor->for_range(0, dst.height, kMinBandRows, rows);
+  } else {
+    rows(0, dst.height);
+  }
 }
 
 }  // namespace roiflow::flow::detail
