@@ -46,8 +46,9 @@
 // be right — a forward-backward error that is high, a size change no object makes, a box as large
 // as the frame, a box that moves with the background right after the target moved unlike it, a
 // look that matches none of the target's (first, recent, remembered) — and declares the target
-// lost (LostReason says which). While lost, the box coasts and the appearance is searched over a
-// widening window around it; only a confident match takes the target back.
+// lost (LostReason says which). While lost, the box follows the flow where it holds (else it
+// coasts) and the appearance is searched over a widening window around it; only a confident match
+// takes the target back.
 //
 // The object is lost when too few of its pixels pass the forward-backward check or its box has
 // too little texture (unless the appearance, searched over twice the radius around the
@@ -126,6 +127,9 @@ struct LocalTrackerParams {
   int memory = 4;            // earlier looks kept besides the first (long-term memory), 0..16
   int memory_interval = 25;  // confident frames between two looks kept, >= 1
   double coast_decay = 0.9;  // velocity kept per frame while lost (coasting), [0, 1]
+  bool follow_lost = true;   // while lost, the box follows the flow where its checks pass (the
+                             // target seen from a side no look shows, most often) instead of
+                             // coasting; still reported lost until a look confirms it
   double max_reach = 8;      // while lost, the appearance search around the coasting box widens
                              // from 2 to this many times `search`, 2..100
   void validate() const;     // throws roiflow::Error naming the bad value
