@@ -1,6 +1,5 @@
 // roiflow benchmark: OTB one-pass evaluation of roiflow and OpenCV's trackers over every sequence
 // of a folder, in one run (pipeline/benchmark.hpp).
-#include <algorithm>
 #include <iostream>
 
 #include "cli_common.hpp"
@@ -8,97 +7,58 @@
 #include "stages/box_tracker.hpp"
 
 namespace roiflow::cli {
-namespace {
-
-struct BenchmarkCommand {
-  LkOptions lk;
-  std::string out;
-  bool tracks = false;
-  pipeline::BenchmarkOptions run;  // DIR, --trackers, --sequences, --max-frames, --roi, ...
-  bool progress = true;
-};
-
-void run_benchmark_command(const BenchmarkCommand& cmd) {
-  pipeline::BenchmarkOptions options = cmd.run;
-  options.threads = cmd.lk.threads;
-  options.roiflow.lk = lk_params(cmd.lk);
-  try {
-    options.roiflow.validate();
-  } catch (const Error& e) {
-    throw UsageError(e.what());
-  }
-  const auto& known = stages::box_tracker_names();
-  for (const std::string& t : options.trackers) {
-    if (std::find(known.begin(), known.end(), t) == known.end()) {
-      throw UsageError("--trackers: unknown tracker '" + t + "' (known: " + joined(known, ",") +
-                       ")");
-    }
-  }
-  pipeline::check_benchmark_out(cmd.out);
-  if (cmd.progress) {
-    options.on_sequence = [](const std::string& line) {
-      std::cerr << "benchmark: " << line << "\n";
-    };
-  }
-  const pipeline::BenchmarkResult result = pipeline::run_benchmark(options);
-  const std::vector<std::string> written = pipeline::write_benchmark(result, cmd.out, cmd.tracks);
-  std::cout << eval::format_benchmark_markdown(result.rows, result.means) << "\nbenchmarked "
-            << result.means.size() << " trackers on "
-            << result.rows.size() / std::max<std::size_t>(1, result.means.size()) << " sequences, "
-            << options.threads << " at once; wrote " << joined(written) << "\n";
-}
-
-}  // namespace
 
 void add_benchmark_command(CLI::App& app, int& /*exit_code*/) {
-  static BenchmarkCommand cmd;
-  cmd.run.trackers = {"roiflow", "csrt", "kcf", "mosse", "medianflow"};
+  static LkOptions lk;
+  static std::string out;
+  static bool tracks = false, progress = true;
+  static pipeline::BenchmarkOptions run;  // DIR, --trackers, --sequences, --max-frames, --roi, ...
+  run.trackers = {"roiflow", "csrt", "kcf", "mosse", "medianflow"};
   CLI::App* sub = app.add_subcommand(
       "benchmark",
       "OTB one-pass evaluation of roiflow and OpenCV's trackers over a folder of sequences: "
       "AUC, precision@20, mean IoU, frames/s; Markdown, CSV and SVG plots");
-  sub->add_option("DIR", cmd.run.dir,
-                  "OTB-layout folder: <seq>/img/0001.jpg ... and <seq>/groundtruth_rect.txt "
-                  "(x,y,w,h, or TinyTLP's 6 columns; NaN lines = target absent, not scored); "
-                  "or one such sequence folder")
+  sub->add_option("DIR", run.dir,
+                  "OTB-layout folder, <seq>/img/*.jpg and <seq>/groundtruth_rect.txt (NaN "
+                  "lines not scored), or one sequence folder (docs/BENCHMARK.md)")
       ->type_name("DIR")
       ->required();
-  sub->add_option("--out", cmd.out,
-                  "folder for benchmark.md, benchmark.csv, success.svg, precision.svg (created "
-                  "if missing)")
+  sub->add_option("--out", out, "folder for benchmark.md/.csv, success.svg, precision.svg")
       ->type_name("DIR")
       ->required();
-  sub->add_option("--trackers", cmd.run.trackers, "trackers to run, in the order to report")
+  sub->add_option("--trackers", run.trackers, "trackers to run, in the order to report")
       ->type_name("LIST")
       ->delimiter(',')
+      ->check([](const std::string& t) { return stages::box_tracker_check(t); })
       ->capture_default_str();
-  sub->add_option("--sequences", cmd.run.sequences, "only these sequences (folder names)")
+  sub->add_option("--sequences", run.sequences, "only these sequences (folder names)")
       ->type_name("LIST")
       ->delimiter(',');
-  sub->add_option("--max-frames", cmd.run.max_frames,
+  sub->add_option("--max-frames", run.max_frames,
                   "at most N frames of each sequence, scored as a prefix (0 = all)")
       ->type_name("N")
       ->check(CLI::Range(0LL, 1000000000LL));
-  sub->add_option("--roi", cmd.run.roiflow.roi, "roiflow: side of the local region in pixels")
-      ->check(CLI::Range(8, 4096))
-      ->capture_default_str();
-  sub->add_option("--lk-patches", cmd.run.roiflow.local.lk_patches,
-                  "roiflow: LK's pyramid level keeps this many LK patches across the object "
-                  "(0 = always full resolution)")
-      ->check(CLI::Range(0.0, 100.0))
-      ->capture_default_str();
-  sub->add_flag(
-      "--tracks", cmd.tracks,
-      "also write every run's track log, OUT/tracks/<sequence>/<tracker>.csv (the format of "
-      "roiflow track --log; roiflow score reads it)");
-  sub->add_flag("!--no-progress", cmd.progress, "no line per finished sequence on stderr");
-  cmd.lk.threads = pipeline::default_threads();
-  add_lk_options(*sub, cmd.lk);
+  add_tracker_options(*sub, run.roiflow, nullptr, "roiflow: ");
+  sub->add_flag("--tracks", tracks,
+                "also write every run's track log, OUT/tracks/<sequence>/<tracker>.csv");
+  sub->add_flag("!--no-progress", progress, "no line per finished sequence on stderr");
+  lk.threads = pipeline::default_threads();
+  add_lk_options(*sub, lk);
   sub->get_option("--threads")
-      ->description(
-          "sequences run at once; every tracker call is single-threaded and timed with its "
-          "thread's CPU clock, so frames/s does not depend on it");
-  sub->callback([] { run_benchmark_command(cmd); });
+      ->description("sequences at once (each tracker call runs on one thread, CPU-timed)");
+  sub->callback([] {
+    pipeline::BenchmarkOptions o = run;
+    o.threads = lk.threads;
+    o.roiflow.lk = lk_params(lk);
+    as_usage([&] { o.roiflow.validate(); });
+    pipeline::check_benchmark_out(out);
+    if (progress) {
+      o.on_sequence = [](const std::string& line) { std::cerr << "benchmark: " << line << "\n"; };
+    }
+    const pipeline::BenchmarkResult result = pipeline::run_benchmark(o);
+    const std::vector<std::string> written = pipeline::write_benchmark(result, out, tracks);
+    std::cout << pipeline::benchmark_text(result, o.threads, written);
+  });
 }
 
 }  // namespace roiflow::cli

@@ -1,12 +1,13 @@
 #include "cli_common.hpp"
 
+#include <iostream>
 #include <limits>
-#include <opencv2/imgcodecs.hpp>
 
 #include "flow/lk_options.hpp"
 #include "pipeline/tbb_executor.hpp"
 
 namespace roiflow::cli {
+
 void add_lk_options(CLI::App& cmd, LkOptions& lk) {
   const std::string group = "Lucas-Kanade parameters (default: the preset's)";
   cmd.add_option("--preset", lk.preset, "parameter set the options below override")
@@ -50,12 +51,13 @@ flow::LkParams lk_params(const LkOptions& lk) {
   flow::LkParams params = flow::LkParams::preset(lk.preset);
   for (const auto& override_value : lk.overrides)
     override_value(params);
-  try {
-    params.validate();
-  } catch (const Error& e) {
-    throw UsageError(e.what());
-  }
+  as_usage([&] { params.validate(); });
   return params;
+}
+
+int run_end(const pipeline::Ending& end) {
+  if (end.exit_code != 0) std::cerr << "roiflow: error: " << end.message << "\n";
+  return end.exit_code;
 }
 
 void add_run_outputs(CLI::App& sub, std::string& video, std::string& summary, bool& progress,
@@ -67,6 +69,37 @@ void add_run_outputs(CLI::App& sub, std::string& video, std::string& summary, bo
   sub.add_flag("!--no-progress", progress, "no progress bar on the terminal");
 }
 
+std::pair<CLI::Option*, CLI::Option*> add_pair_inputs(CLI::App& sub, std::string& dir,
+                                                      std::vector<std::vector<std::string>>& pairs,
+                                                      const std::string& dir_help) {
+  CLI::Option* d = sub.add_option("DIR", dir, dir_help)->type_name("DIR");
+  CLI::Option* p = sub.add_option("--pair", pairs, "an image pair and its ground truth; repeatable")
+                       ->type_name("A B GT")
+                       ->type_size(3)
+                       ->allow_extra_args(false);
+  d->excludes(p);
+  return {d, p};
+}
+
+void add_tracker_options(CLI::App& sub, stages::TrackerParams& tracker, std::string* mode,
+                         const std::string& who) {
+  sub.add_option("--roi", tracker.roi, who + "side of the local region in pixels")
+      ->check(CLI::Range(8, 4096))
+      ->capture_default_str();
+  sub.add_option("--lk-patches", tracker.local.lk_patches,
+                 who +
+                     "LK runs on the coarsest pyramid level where the object's shorter side "
+                     "spans this many LK patches (0 = always full resolution)")
+      ->check(CLI::Range(0.0, 100.0))
+      ->capture_default_str();
+  if (mode == nullptr) return;
+  sub.add_option("--mode", *mode,
+                 "local: LK in the local region, global fallback; global: the "
+                 "whole frame every frame (the paper's baseline)")
+      ->check(CLI::IsMember({"local", "global"}))
+      ->capture_default_str();
+}
+
 void add_source_options(CLI::App& sub, pipeline::SourceOptions& source, int& in_flight) {
   sub.add_option("--start", source.start, "index of the first frame to read")
       ->check(CLI::Range(0LL, std::numeric_limits<long long>::max()));
@@ -76,8 +109,7 @@ void add_source_options(CLI::App& sub, pipeline::SourceOptions& source, int& in_
                  "frames decoded ahead and in the pipeline at most (0 = 2 x threads + 2)")
       ->check(CLI::Range(0, 1024));
   sub.add_option("--decode-threads", source.decode_threads,
-                 "a video's FFmpeg decoder threads (0 = one up to 1280x720, where more cost more "
-                 "than they give, else FFmpeg's choice)")
+                 "FFmpeg decoder threads (0 = one up to 1280x720, else FFmpeg's choice)")
       ->check(CLI::Range(0, 64));
 }
 

@@ -1,7 +1,6 @@
-// What the roiflow subcommands share: the Lucas-Kanade options (declared once, added to any
-// subcommand), output checks, a video run's options and summary line. A new subcommand lives in
-// apps/<name>_command.cpp: add_<name>_command declares its options, its callback calls a library
-// function and prints the result; one declaration below and one line in main() register it.
+// What the subcommands share: the LK options (declared once), groups of options, usage checks.
+// A new subcommand lives in apps/<name>_command.cpp: add_<name>_command declares its options,
+// its callback calls a library function and prints; a declaration below and main() register it.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -18,8 +17,7 @@
 
 namespace roiflow::cli {
 
-// The preset and the overrides given on the command line, applied on top of it in order.
-struct LkOptions {
+struct LkOptions {  // the preset, then the overrides given, in order
   std::string preset = "paper";
   std::vector<std::function<void(flow::LkParams&)>> overrides;
   int threads = 1;
@@ -30,22 +28,36 @@ void add_lk_options(CLI::App& cmd, LkOptions& lk);
 // The preset with the overrides applied; out-of-range values throw UsageError.
 flow::LkParams lk_params(const LkOptions& lk);
 
+// Runs `check` (a validate()): its roiflow::Error becomes a UsageError (exit code 2).
+template <class Check>
+void as_usage(Check&& check) {
+  try {
+    check();
+  } catch (const Error& e) {
+    throw UsageError(e.what());
+  }
+}
+
+// A run's ending: an error line on stderr unless it completed; returns the exit code.
+int run_end(const pipeline::Ending& end);
+
 // --out (to `video`), --summary and --no-progress.
 void add_run_outputs(CLI::App& sub, std::string& video, std::string& summary, bool& progress,
                      const std::string& video_help);
+// DIR and --pair A B GT (repeatable), which exclude each other; returns the two options.
+std::pair<CLI::Option*, CLI::Option*> add_pair_inputs(CLI::App& sub, std::string& dir,
+                                                      std::vector<std::vector<std::string>>& pairs,
+                                                      const std::string& dir_help);
+// --roi and --lk-patches (prefixed "roiflow: " in `who`), and --mode when `mode` is given.
+void add_tracker_options(CLI::App& sub, stages::TrackerParams& tracker, std::string* mode = nullptr,
+                         const std::string& who = "");
 // --start, --max-frames, --in-flight, --decode-threads.
 void add_source_options(CLI::App& sub, pipeline::SourceOptions& source, int& in_flight);
 
-// The subcommands; a video run's exit code goes to `exit_code`.
-void add_flow_command(CLI::App& app, int& exit_code);
-void add_eval_command(CLI::App& app, int& exit_code);
-void add_score_command(CLI::App& app, int& exit_code);
-void add_track_command(CLI::App& app, int& exit_code);
-void add_dense_command(CLI::App& app, int& exit_code);
-void add_demo_command(CLI::App& app, int& exit_code);
-void add_sweep_command(CLI::App& app, int& exit_code);
-void add_benchmark_command(CLI::App& app, int& exit_code);
-void add_scaling_command(CLI::App& app, int& exit_code);
-void add_batch_command(CLI::App& app, int& exit_code);
+// The subcommands; a run's exit code goes to `exit_code`.
+using AddCommand = void(CLI::App& app, int& exit_code);
+AddCommand add_flow_command, add_eval_command, add_score_command, add_track_command,
+    add_dense_command, add_demo_command, add_sweep_command, add_benchmark_command,
+    add_scaling_command, add_batch_command;
 
 }  // namespace roiflow::cli

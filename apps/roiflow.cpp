@@ -4,7 +4,6 @@
 // (UsageError included), 1 for anything that fails at run time. Inputs and output locations are
 // checked before any computation and outputs are written atomically: a failed run leaves none.
 #include <CLI/CLI.hpp>
-#include <algorithm>
 #include <cstdlib>
 #include <iostream>
 #include <opencv2/core/utils/logger.hpp>
@@ -12,17 +11,9 @@
 
 #include "cli_common.hpp"
 
-namespace {
-
 using namespace roiflow;
-using namespace roiflow::cli;
 
-// OpenCV's messages span lines; the CLI promises one.
-std::string one_line(std::string text) {
-  std::replace_if(
-      text.begin(), text.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
-  return text.erase(text.find_last_not_of(' ') + 1);
-}
+namespace {
 
 int report_error(const std::string& message, int exit_code) {
   std::cerr << "roiflow: error: " << one_line(message) << "\n";
@@ -40,25 +31,18 @@ int report_usage(const CLI::App& app, const std::string& message) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // The CLI promises one error line: OpenCV's and FFmpeg's own diagnostics (decoder complaints
-  // about a damaged file, backends that cannot open a camera) would add lines of their own, and
+  // One error line: OpenCV's and FFmpeg's own diagnostics would add lines of their own, and
   // every failure they describe reaches the user as roiflow's error anyway.
   setenv("OPENCV_FFMPEG_LOGLEVEL", "-8", 0);  // AV_LOG_QUIET, unless the user set it
   cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
   CLI::App app{"roiflow: realtime dense and local Lucas-Kanade optical flow", "roiflow"};
   app.require_subcommand(1);
   int exit_code = 0;  // a video run's; parse and run-time failures are caught below
-  add_flow_command(app, exit_code);
-  add_eval_command(app, exit_code);
-  add_score_command(app, exit_code);
-  add_track_command(app, exit_code);
-  add_dense_command(app, exit_code);
-  add_demo_command(app, exit_code);
-  add_sweep_command(app, exit_code);
-  add_scaling_command(app, exit_code);
-  add_benchmark_command(app, exit_code);
-  add_batch_command(app, exit_code);
-
+  using namespace roiflow::cli;
+  for (auto add : {add_flow_command, add_eval_command, add_score_command, add_track_command,
+                   add_dense_command, add_demo_command, add_sweep_command, add_scaling_command,
+                   add_benchmark_command, add_batch_command})
+    add(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

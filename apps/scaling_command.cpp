@@ -1,94 +1,47 @@
-// roiflow scaling: the same run at several thread counts; throughput, speedup and efficiency
-// (pipeline::run_scaling, src/pipeline/scaling.hpp).
-//
-//   roiflow scaling synthetic:300:640x480:16 --threads 1,2 --mode local --out out/scaling
-//   -> out/scaling/scaling.csv (threads,fps,tracker_fps,speedup,efficiency), scaling.svg
-#include <CLI/CLI.hpp>
-#include <filesystem>
+// roiflow scaling: the same run at several thread counts; fps, speedup and efficiency as a table,
+// scaling.csv and scaling.svg (pipeline/scaling.hpp).
 #include <iostream>
-#include <string>
-#include <vector>
 
 #include "cli_common.hpp"
-#include "core/atomic_write.hpp"
 #include "pipeline/scaling.hpp"
-#include "report/plot.hpp"
 
 namespace roiflow::cli {
-namespace {
-
-namespace fs = std::filesystem;
-
-struct ScalingCommand {
-  LkOptions lk;
-  std::string input;
-  std::vector<int> threads;
-  std::string mode = "local";
-  std::string out;
-  long long max_frames = 0;
-  int repeats = 1;
-};
-
-void run_scaling_command(const ScalingCommand& cmd) {
-  pipeline::ScalingOptions o;
-  o.input = cmd.input;
-  o.threads = cmd.threads;
-  o.mode = pipeline::scaling_mode_from_string(cmd.mode);
-  o.lk = lk_params(cmd.lk);
-  o.max_frames = cmd.max_frames;
-  o.repeats = cmd.repeats;
-  try {
-    o.validate();
-  } catch (const Error& e) {
-    throw UsageError(e.what());
-  }
-  make_output_dir(cmd.out, "--out");
-  const pipeline::ScalingResult r = pipeline::run_scaling(o);
-  const std::string csv = (fs::path(cmd.out) / "scaling.csv").string();
-  const std::string svg = (fs::path(cmd.out) / "scaling.svg").string();
-  write_text_atomically(csv, pipeline::scaling_csv(r));
-  report::write_plot_svg(svg, pipeline::scaling_plot(r));
-  std::cout << "scaling " << pipeline::to_string(r.mode) << " mode, " << r.input << "\n"
-            << "threads      fps  tracker_fps  speedup  efficiency\n";
-  for (const pipeline::ScalingRow& row : r.rows) {
-    std::printf("%7d %8.1f %12.1f %8.2f %11.2f\n", row.threads, row.fps, row.tracker_fps,
-                row.speedup, row.efficiency);
-  }
-  std::cout << std::flush << "wrote " << csv << ", " << svg << "\n";
-}
-
-}  // namespace
 
 void add_scaling_command(CLI::App& app, int& /*exit_code*/) {
-  static ScalingCommand cmd;
+  static LkOptions lk;
+  static pipeline::ScalingOptions run;  // INPUT, --threads, --max-frames, --repeat
+  static std::string mode = "local", out;
   CLI::App* sub = app.add_subcommand(
       "scaling", "The same run at several thread counts: fps, speedup, efficiency; CSV and SVG");
-  sub->add_option("INPUT", cmd.input,
-                  "video file, image-sequence folder, or synthetic:N[:WxH][:OBJECTS]")
+  sub->add_option("INPUT", run.input, "video file, image folder, or synthetic:N[:WxH][:OBJECTS]")
       ->required();
-  // The LK options' own --threads (one count) gives way to the list.
-  add_lk_options(*sub, cmd.lk);
+  add_lk_options(*sub, lk);  // its --threads (one count) gives way to the list
   sub->remove_option(sub->get_option("--threads"));
-  sub->add_option("--threads", cmd.threads, "comma-separated thread counts, e.g. 1,2,4")
+  sub->add_option("--threads", run.threads, "comma-separated thread counts, e.g. 1,2,4")
       ->type_name("LIST")
       ->delimiter(',')
       ->expected(1, 64)
       ->required();
-  sub->add_option("--mode", cmd.mode,
-                  "local: tracking with the local treatment; global: the global treatment every "
-                  "frame; dense: dense flow of every frame pair")
+  sub->add_option("--mode", mode,
+                  "local or global: tracking with that treatment; dense: every frame pair's flow")
       ->check(CLI::IsMember({"local", "global", "dense"}))
       ->capture_default_str();
-  sub->add_option("--out", cmd.out, "folder for scaling.csv and scaling.svg (created if missing)")
-      ->type_name("DIR")
-      ->required();
-  sub->add_option("--max-frames", cmd.max_frames, "frames of the input to use (0 = all)")
+  sub->add_option("--out", out, "folder for scaling.csv and scaling.svg")->required();
+  sub->add_option("--max-frames", run.max_frames, "frames of the input to use (0 = all)")
       ->check(CLI::Range(0LL, 1'000'000'000LL));
-  sub->add_option("--repeat", cmd.repeats,
-                  "runs per thread count; the fastest is kept (noise of a shared machine)")
+  sub->add_option("--repeat", run.repeats, "runs per thread count, the fastest kept")
       ->check(CLI::Range(1, 100))
       ->capture_default_str();
-  sub->callback([] { run_scaling_command(cmd); });
+  sub->callback([] {
+    pipeline::ScalingOptions o = run;
+    o.mode = pipeline::scaling_mode_from_string(mode);
+    o.lk = lk_params(lk);
+    as_usage([&] { o.validate(); });
+    make_output_dir(out, "--out");
+    const pipeline::ScalingResult r = pipeline::run_scaling(o);
+    const std::vector<std::string> written = pipeline::write_scaling(r, out);
+    std::cout << pipeline::scaling_text(r) << "wrote " << joined(written) << "\n";
+  });
 }
 
 }  // namespace roiflow::cli

@@ -1,7 +1,5 @@
-// roiflow sweep: error and run time of dense LK as one parameter varies (paper Fig. 7, 8).
-//
-//   roiflow sweep data/middlebury --param patch --out out/sweep
-//   -> out/sweep/sweep.csv, out/sweep/patch.svg
+// roiflow sweep: error and run time of dense LK as one parameter varies (paper Fig. 7, 8):
+// sweep.csv and one <param>.svg (pipeline::run_sweep).
 #include <filesystem>
 #include <iostream>
 
@@ -10,83 +8,52 @@
 #include "pipeline/eval_runs.hpp"
 
 namespace roiflow::cli {
-namespace {
-
-namespace fs = std::filesystem;
-
-struct SweepCommand {
-  LkOptions lk;
-  std::string dir;
-  std::vector<std::vector<std::string>> pairs;  // A, B, ground truth
-  std::string param = "all";
-  std::vector<double> values;
-  int max_pairs = 0;
-  bool progress = true;
-  pipeline::SweepRunOptions run;  // --out, --repeat
-};
-
-void run_sweep(const SweepCommand& cmd) {
-  pipeline::SweepRunOptions o = cmd.run;
-  o.base = lk_params(cmd.lk);
-  // Every value is checked before the first pair is read.
-  o.plan = eval::sweep_plan(cmd.param, cmd.values, o.base);
-  o.pairs = eval::middlebury_or_listed(cmd.dir, cmd.pairs, cmd.max_pairs);
-  o.subtitle =
-      (cmd.dir.empty() ? "" : fs::path(cmd.dir).lexically_normal().filename().string() + ", ") +
-      "preset " + cmd.lk.preset;
-  o.threads = cmd.lk.threads;
-  if (cmd.progress) {
-    o.progress = [](const eval::SweepRow& r, std::size_t i, std::size_t n) {
-      std::cerr << eval::sweep_progress_line(r, i, n) << std::endl;
-    };
-  }
-  const pipeline::SweepRunResult r = pipeline::run_sweep(o);
-  std::cout << eval::sweep_table(r.rows) << "swept " << r.rows.size() << " values over "
-            << o.pairs.size() << " pairs, " << cmd.lk.threads
-            << " threads, time per pair the fastest of " << o.repeats
-            << (o.repeats == 1 ? " run" : " runs") << "; wrote " << joined(r.written) << "\n";
-}
-
-}  // namespace
 
 void add_sweep_command(CLI::App& app, int& /*exit_code*/) {
-  static SweepCommand cmd;
+  static LkOptions lk;
+  static std::string dir, param = "all";
+  static std::vector<std::vector<std::string>> pairs;  // A, B, ground truth
+  static std::vector<double> values;
+  static int max_pairs = 0;
+  static bool progress = true;
+  static pipeline::SweepRunOptions run;  // --out, --repeat
   CLI::App* sub = app.add_subcommand(
       "sweep", "Dense flow error and time as one LK parameter varies; CSV and SVG plots");
-  CLI::Option* dir =
-      sub->add_option("DIR", cmd.dir,
-                      "Middlebury tree: DIR/<seq>/frame10.png, frame11.png, flow10.flo")
-          ->type_name("DIR");
-  CLI::Option* pair = sub->add_option("--pair", cmd.pairs, "an image pair and its .flo; repeatable")
-                          ->type_name("A B GT")
-                          ->type_size(3)
-                          ->allow_extra_args(false);
-  dir->excludes(pair);
-  sub->add_option("--param", cmd.param, "the parameter to vary (all: each in turn)")
-      ->type_name("NAME")
+  add_pair_inputs(*sub, dir, pairs,
+                  "Middlebury tree: DIR/<seq>/frame10.png, frame11.png, flow10.flo");
+  sub->add_option("--param", param, "the parameter to vary (all: each in turn)")
       ->check(CLI::IsMember({"patch", "iterations", "levels", "sigma", "lambda", "all"}))
       ->capture_default_str();
-  sub->add_option("--values", cmd.values,
+  sub->add_option("--values", values,
                   "comma-separated values (default: patch 3..31, iterations 1..10, levels 1..6, "
                   "sigma 0..3, lambda 1e-8..1e-2)")
       ->type_name("LIST")
       ->delimiter(',')
       ->expected(1, 200);
-  sub->add_option("--out", cmd.run.out_dir,
-                  "folder for sweep.csv and <param>.svg (created if missing)")
-      ->type_name("DIR")
-      ->required();
-  sub->add_option("--max-pairs", cmd.max_pairs, "use only the first N pairs (0 = all)")
+  sub->add_option("--out", run.out_dir, "folder for sweep.csv and <param>.svg")->required();
+  sub->add_option("--max-pairs", max_pairs, "use only the first N pairs (0 = all)")
       ->check(CLI::Range(0, 1000000));
-  sub->add_option(
-         "--repeat", cmd.run.repeats,
-         "runs of each pair per value; its time is the fastest (noise of a shared machine)")
+  sub->add_option("--repeat", run.repeats, "runs of each pair per value, the fastest kept")
       ->check(CLI::Range(1, 100))
       ->capture_default_str();
-  sub->add_flag("!--no-progress", cmd.progress, "no progress line per value on stderr");
-  cmd.lk.threads = pipeline::default_threads();
-  add_lk_options(*sub, cmd.lk);
-  sub->callback([] { run_sweep(cmd); });
+  sub->add_flag("!--no-progress", progress, "no progress line per value on stderr");
+  lk.threads = pipeline::default_threads();
+  add_lk_options(*sub, lk);
+  sub->callback([] {
+    pipeline::SweepRunOptions o = run;
+    o.base = lk_params(lk);
+    o.plan = eval::sweep_plan(param, values, o.base);  // every value checked before any work
+    o.pairs = eval::middlebury_or_listed(dir, pairs, max_pairs);
+    const std::string name = std::filesystem::path(dir).lexically_normal().filename().string();
+    o.subtitle = (dir.empty() ? "" : name + ", ") + "preset " + lk.preset;
+    o.threads = lk.threads;
+    if (progress) {
+      o.progress = [](const eval::SweepRow& r, std::size_t i, std::size_t n) {
+        std::cerr << eval::sweep_progress_line(r, i, n) << std::endl;
+      };
+    }
+    std::cout << pipeline::sweep_text(pipeline::run_sweep(o), o);
+  });
 }
 
 }  // namespace roiflow::cli

@@ -1,5 +1,6 @@
 // Text for the places it is shown: numbers with fixed decimals (libfmt), sizes, lists, numbers
-// as the user wrote them, values quoted for an error message, and text made safe for HTML/SVG.
+// as the user wrote them, values quoted for an error message, text made safe for HTML/SVG, CSV
+// fields, and messages on one line.
 //
 //   std::string line = "EPE " + roiflow::fixed(0.12345, 3) + " px at " +
 //                      roiflow::size_text({640, 480});          // "EPE 0.123 px at 640x480"
@@ -7,6 +8,8 @@
 //   const std::string error = "bad number " + roiflow::quoted_excerpt("12x") + ", roi " +
 //                             roiflow::number_text(0.5);        // "bad number '12x', roi 0.5"
 //   const std::string svg = "<text>" + roiflow::escape_markup("a < b") + "</text>";
+//   const std::string cell = roiflow::csv_field("a,b");     // "\"a,b\""
+//   const std::string said = roiflow::one_line("bad\nframe\n");  // "bad frame"
 #pragma once
 
 #include <fmt/format.h>
@@ -36,6 +39,26 @@ inline std::string joined(const std::vector<std::string>& items, std::string_vie
   for (const std::string& item : items)
     list += (list.empty() ? "" : std::string(sep)) + item;
   return list;
+}
+
+// A CSV field: quoted (quotes doubled) when it holds a comma, a quote or a line break.
+inline std::string csv_field(const std::string& text) {
+  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (char c : text) {
+    if (c == '"') quoted += '"';
+    quoted += c;
+  }
+  return quoted + '"';
+}
+
+// Text on one line: line breaks become spaces, trailing spaces go (OpenCV's messages span lines;
+// the CLI's error is one line).
+inline std::string one_line(std::string text) {
+  for (char& c : text) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  return text.erase(text.find_last_not_of(' ') + 1);
 }
 
 // A number as error messages show it: the shortest stream form ("0.5", "1e-06", "nan"), so that

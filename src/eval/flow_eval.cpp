@@ -113,17 +113,6 @@ void check_same_size(const std::string& name, const std::string& path_a, cv::Siz
               " but '" + path_b + "' is " + size_text(b));
 }
 
-// Sequence names come from folder names, which may hold anything a CSV reader trips on.
-std::string csv_field(const std::string& text) {
-  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
-  std::string quoted = "\"";
-  for (char c : text) {
-    if (c == '"') quoted += '"';
-    quoted += c;
-  }
-  return quoted + '"';
-}
-
 nlohmann::ordered_json errors_json(const flow::FlowErrors& e) {
   return {{"aae_deg", e.aae_deg}, {"epe", e.epe}, {"r1", e.r1},
           {"r3", e.r3},           {"fl", e.fl},   {"pixels", e.pixels}};

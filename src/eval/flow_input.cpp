@@ -41,6 +41,19 @@ std::vector<SceneKind> synthetic_scene_kinds() {
           SceneKind::MovingObject};
 }
 
+FlowInput flow_input(const std::string& frame0, const std::string& frame1,
+                     const std::string& ground_truth, const std::string& scene, cv::Size size) {
+  if (scene.empty()) {
+    if (frame1.empty()) throw UsageError("flow needs two images A B, or --synthetic [scene]");
+    return read_flow_input(frame0, frame1, ground_truth);
+  }
+  if (!frame0.empty()) throw UsageError("give either two images A B or --synthetic, not both");
+  if (!ground_truth.empty()) {
+    throw UsageError("--gt: a --synthetic scene brings its own ground truth");
+  }
+  return synthetic_flow_input(scene, size);
+}
+
 FlowInput synthetic_flow_input(const std::string& name, cv::Size size) {
   for (SceneKind kind : synthetic_scene_kinds()) {
     if (name != to_string(kind)) continue;

@@ -32,6 +32,11 @@ FlowInput read_flow_input(const std::string& frame0, const std::string& frame1,
                           const std::string& ground_truth);
 // `name` is to_string(kind) of one of synthetic_scene_kinds(); throws roiflow::Error otherwise.
 FlowInput synthetic_flow_input(const std::string& name, cv::Size size);
+// `roiflow flow`'s input: the pair frame0, frame1 (with the optional ground truth), or, when
+// `scene` is not empty, that synthetic scene at `size`. Throws UsageError when both or neither
+// are given, or a ground truth with a synthetic scene.
+FlowInput flow_input(const std::string& frame0, const std::string& frame1,
+                     const std::string& ground_truth, const std::string& scene, cv::Size size);
 std::vector<SceneKind> synthetic_scene_kinds();
 
 // "AAE 1.234 deg, EPE 0.1234 px, R1 1.23 %, R3 0.12 %".

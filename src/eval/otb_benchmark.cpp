@@ -12,6 +12,7 @@
 #include <system_error>
 
 #include "core/error.hpp"
+#include "core/text.hpp"
 
 namespace roiflow::eval {
 namespace fs = std::filesystem;
@@ -50,17 +51,6 @@ OtbSequence read_sequence(const fs::path& dir) {
 void append(std::string& out, std::initializer_list<std::string_view> parts) {
   for (std::string_view p : parts)
     out += p;
-}
-
-// A CSV field: quoted (quotes doubled) when it holds a comma, a quote or a line break.
-std::string csv_field(const std::string& text) {
-  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
-  std::string quoted = "\"";
-  for (char c : text) {
-    if (c == '"') quoted += '"';
-    quoted += c;
-  }
-  return quoted + "\"";
 }
 
 // A Markdown table cell: '|' escaped, line breaks as spaces.

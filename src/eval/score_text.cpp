@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "core/error.hpp"
+#include "eval/otb_score.hpp"
 #include "eval/synthetic_input.hpp"
 #include "eval/traffic_scene.hpp"
 
@@ -37,6 +38,26 @@ std::string mot_score_table(const MotScore& s) {
 nlohmann::ordered_json mot_score_json(const MotScore& s) {
   return {{"mota", s.mota}, {"motp", s.motp}, {"idf1", s.idf1},     {"id_switches", s.id_switches},
           {"fp", s.fp},     {"fn", s.fn},     {"frames", s.frames}, {"objects", s.objects}};
+}
+
+std::string score_text(const std::string& track, const std::string& ground_truth, bool mot,
+                       const std::string& format) {
+  const bool json = format == "json";
+  if (mot) {
+    const std::vector<MotBox> truth = read_mot_truth(ground_truth);  // read first
+    const MotScore s = score_mot(read_mot(track, "tracker output"), truth);
+    return json ? mot_score_json(s).dump(2) + "\n" : mot_score_table(s);
+  }
+  const std::vector<cv::Rect2f> boxes = read_track_boxes(track);
+  const std::vector<cv::Rect2f> truth = read_ground_truth(ground_truth);
+  const OtbScore s = score(boxes, truth);
+  if (!json) return score_table(s, boxes.size(), truth.size());
+  return nlohmann::ordered_json({{"auc", s.auc},
+                                 {"precision20", s.precision20},
+                                 {"mean_iou", s.mean_iou},
+                                 {"frames", s.frames}})
+             .dump(2) +
+         "\n";
 }
 
 }  // namespace roiflow::eval

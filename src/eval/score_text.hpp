@@ -1,9 +1,11 @@
-// What `roiflow score` prints for a multi-object track (score --mot): CLEAR-MOT and IDF1 as a
-// table for people, or the headline figures as JSON.
+// What `roiflow score` prints: for a single-object track log against OTB ground truth, AUC,
+// precision@20 and mean IoU; for a multi-object track (score --mot), CLEAR-MOT and IDF1. Each
+// as a table for people, or the headline figures as JSON.
 //
 //   const auto s = roiflow::eval::score_mot(roiflow::eval::read_mot("mot.txt", "tracker output"),
 //                                           roiflow::eval::read_mot("gt.txt", "ground truth"));
 //   std::cout << roiflow::eval::mot_score_table(s);
+//   std::cout << roiflow::eval::score_text("track.csv", "groundtruth_rect.txt", false, "json");
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -20,5 +22,10 @@ std::vector<MotBox> read_mot_truth(const std::string& gt);
 std::string mot_score_table(const MotScore& s);
 // {"mota", "motp", "idf1", "id_switches", "fp", "fn", "frames", "objects"}.
 nlohmann::ordered_json mot_score_json(const MotScore& s);
+
+// `roiflow score TRACK GT [--mot] [--format table|json]`: the files read (ground truth first),
+// scored and formatted. Throws roiflow::Error naming the file for unreadable input.
+std::string score_text(const std::string& track, const std::string& ground_truth, bool mot,
+                       const std::string& format);
 
 }  // namespace roiflow::eval

@@ -21,6 +21,7 @@
 
 #include "core/atomic_write.hpp"
 #include "core/error.hpp"
+#include "core/text.hpp"
 #include "flow/color_code.hpp"
 #include "flow/pyramid.hpp"
 #include "pipeline/tbb_executor.hpp"
@@ -77,24 +78,6 @@ void remove_stale_partials(const fs::path& out, const std::string& stem) {
     if (pid == getpid()) continue;  // this process: another thread's (never: stems are unique)
     if (kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) fs::remove_all(e.path(), ec);
   }
-}
-
-std::string csv_field(const std::string& text) {
-  if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
-  std::string quoted = "\"";
-  for (char c : text) {
-    if (c == '"') quoted += '"';
-    quoted += c;
-  }
-  return quoted + "\"";
-}
-
-std::string fixed(double v, int decimals) {
-  std::ostringstream out;
-  out.setf(std::ios::fixed);
-  out.precision(decimals);
-  out << v;
-  return out.str();
 }
 
 nlohmann::ordered_json status_json(const BatchRow& row) {
@@ -321,6 +304,7 @@ std::vector<BatchRow> run_batch(const std::vector<std::string>& videos,
   const int parallel = std::clamp(options.parallel == 0 ? cap : options.parallel, 1, cap);
   std::vector<BatchRow> rows(videos.size());
   std::mutex report;
+  std::vector<BatchRow> ended(videos.size());  // under `report`: what batch.csv holds
   std::vector<std::size_t> order(videos.size());
   for (std::size_t i = 0; i < order.size(); ++i)
     order[i] = i;
@@ -334,13 +318,14 @@ std::vector<BatchRow> run_batch(const std::vector<std::string>& videos,
     tbb::parallel_for_each(workers.begin(), workers.end(), [&](int) {
       for (std::size_t i = next++; i < videos.size(); i = next++) {
         rows[i] = run_one(videos[i], out, names[i], options, executor);
-        if (options.on_row) {
-          std::lock_guard<std::mutex> lock(report);
-          options.on_row(rows[i]);
-        }
+        std::lock_guard<std::mutex> lock(report);
+        ended[i] = rows[i];
+        if (!options.csv.empty()) write_batch_csv(options.csv, ended);
+        if (options.on_row) options.on_row(rows[i]);
       }
     });
   });
+  if (!options.csv.empty()) write_batch_csv(options.csv, rows);
   return rows;
 }
 
@@ -352,6 +337,46 @@ void write_batch_csv(const std::string& path, const std::vector<BatchRow>& rows)
             fixed(r.fps, 2) + "," + fixed(r.seconds, 3) + "\n";
   }
   write_text_atomically(path, text);
+}
+
+std::string batch_row_line(const BatchRow& row) {
+  if (row.skipped) return "skipped " + row.video + " (done earlier)";
+  if (row.status == "done") {
+    return "done    " + row.video + " (" + std::to_string(row.frames) + " frames, " +
+           fixed(row.fps, 1) + " fps) -> " + row.folder;
+  }
+  const std::size_t colon = row.status.find(':');
+  if (colon == std::string::npos) return row.status + "  " + row.video;
+  return row.status.substr(0, colon) + "  " + row.video + ":" + row.status.substr(colon + 1);
+}
+
+BatchTally tally(const std::vector<BatchRow>& rows) {
+  BatchTally t;
+  for (const BatchRow& r : rows) {
+    ++(r.skipped                 ? t.skipped
+       : r.status == "done"      ? t.ran
+       : r.status == "cancelled" ? t.cancelled
+                                 : t.failed);
+  }
+  return t;
+}
+
+std::string batch_summary_line(const std::vector<BatchRow>& rows, const std::string& csv) {
+  const BatchTally t = tally(rows);
+  return "batch: " + std::to_string(rows.size()) + " videos: " + std::to_string(t.ran) + " run, " +
+         std::to_string(t.skipped) + " already done, " + std::to_string(t.failed) + " failed" +
+         (t.cancelled > 0 ? ", " + std::to_string(t.cancelled) + " cancelled" : std::string()) +
+         (csv.empty() ? std::string() : "; wrote " + csv);
+}
+
+Ending batch_ending(const std::vector<BatchRow>& rows) {
+  if (caught_signal() != 0) {
+    return {128 + caught_signal(), "interrupted; finished videos are kept, run again to resume"};
+  }
+  const long long failed = tally(rows).failed;
+  if (failed == 0) return {};
+  return {1, std::to_string(failed) + " of " + std::to_string(rows.size()) +
+                 " videos failed (see batch.csv); run again to retry them"};
 }
 
 }  // namespace roiflow::pipeline

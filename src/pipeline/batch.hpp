@@ -37,6 +37,7 @@
 #include <vector>
 
 #include "flow/dense_lk.hpp"
+#include "pipeline/signals.hpp"
 #include "stages/tracker.hpp"
 
 namespace roiflow::pipeline {
@@ -63,7 +64,11 @@ struct BatchOptions {
   int threads = 0;                              // arena threads; 0 = all hardware threads
   int parallel = 0;  // videos at once; 0 = the most allowed (threads, track: threads - 1)
   const std::atomic<bool>* cancel = nullptr;
-  // Called (from the arena's threads, one call at a time) as each video ends or is skipped.
+  // batch.csv, kept current as videos end (the rows of the videos ended so far, in input order),
+  // so a killed batch leaves the rows of what it finished; empty = none.
+  std::string csv;
+  // Called (from the arena's threads, one call at a time) as each video ends or is skipped, after
+  // its row is in `csv`.
   std::function<void(const BatchRow&)> on_row;
 };
 
@@ -84,5 +89,21 @@ std::vector<BatchRow> run_batch(const std::vector<std::string>& videos,
 // batch.csv: `video,status,frames,fps,seconds`, one row per video (fields with a comma or a
 // quote are quoted), written atomically.
 void write_batch_csv(const std::string& path, const std::vector<BatchRow>& rows);
+
+// The line `roiflow batch` prints as a video ends: "done    V (N frames, F fps) -> FOLDER",
+// "skipped V (done earlier)", "failed  V: message", "cancelled  V".
+std::string batch_row_line(const BatchRow& row);
+
+struct BatchTally {
+  long long ran = 0, skipped = 0, failed = 0, cancelled = 0;
+};
+BatchTally tally(const std::vector<BatchRow>& rows);
+
+// "batch: N videos: R run, S already done, F failed[, C cancelled][; wrote CSV]".
+std::string batch_summary_line(const std::vector<BatchRow>& rows, const std::string& csv);
+
+// How the batch ended, for the CLI: 128 + the signal after SIGINT/SIGTERM (finished videos are
+// kept), 1 when a video failed, else 0.
+Ending batch_ending(const std::vector<BatchRow>& rows);
 
 }  // namespace roiflow::pipeline

@@ -16,6 +16,7 @@
 
 #include "core/atomic_write.hpp"
 #include "core/error.hpp"
+#include "core/text.hpp"
 #include "pipeline/tbb_executor.hpp"
 #include "report/otb_plot.hpp"
 #include "stages/box_tracker.hpp"
@@ -237,6 +238,15 @@ std::vector<std::string> write_benchmark(const BenchmarkResult& result, const st
     written.push_back((dir / "tracks").string());
   }
   return written;
+}
+
+std::string benchmark_text(const BenchmarkResult& result, int threads,
+                           const std::vector<std::string>& written) {
+  const std::size_t trackers = result.means.size();
+  return eval::format_benchmark_markdown(result.rows, result.means) + "\nbenchmarked " +
+         std::to_string(trackers) + " trackers on " +
+         std::to_string(result.rows.size() / std::max<std::size_t>(1, trackers)) + " sequences, " +
+         std::to_string(threads) + " at once; wrote " + joined(written) + "\n";
 }
 
 }  // namespace roiflow::pipeline

@@ -54,4 +54,9 @@ void check_benchmark_out(const std::string& out_dir);
 std::vector<std::string> write_benchmark(const BenchmarkResult& result, const std::string& out_dir,
                                          bool tracks = false);
 
+// What `roiflow benchmark` prints: the Markdown table, then "benchmarked T trackers on S
+// sequences, N at once; wrote FILES".
+std::string benchmark_text(const BenchmarkResult& result, int threads,
+                           const std::vector<std::string>& written);
+
 }  // namespace roiflow::pipeline

@@ -5,6 +5,10 @@
 
 #include "core/atomic_write.hpp"
 #include "core/error.hpp"
+#include "core/text.hpp"
+#include "eval/flo_io.hpp"
+#include "eval/image_io.hpp"
+#include "flow/color_code.hpp"
 #include "pipeline/tbb_executor.hpp"
 #include "report/sweep_plot.hpp"
 
@@ -28,6 +32,39 @@ FlowRun run_flow(const eval::FlowInput& in, const flow::LkParams& params, int th
   return r;
 }
 
+void FlowFiles::check() const {
+  check_output_path(flo, "-o");
+  if (!color.empty()) eval::check_image_output(color, "--color");
+  if (!legend.empty()) eval::check_image_output(legend, "--legend");
+}
+
+std::vector<std::string> write_flow_files(const FlowFiles& files, const eval::FlowInput& in,
+                                          const FlowRun& run) {
+  if (run.errors && run.errors->pixels == 0) {
+    throw Error("--gt: the ground truth is unknown at every pixel");
+  }
+  std::vector<std::string> written{files.flo};
+  eval::write_flo(files.flo, run.flow);
+  if (!files.color.empty()) {
+    // Against a ground truth, the truth's largest vector saturates, so the two pictures compare.
+    const float scale = in.truth.empty() ? -1.f : flow::max_magnitude(in.truth);
+    eval::write_image_atomically(written.emplace_back(files.color),
+                                 flow::flow_to_color(run.flow, scale));
+  }
+  if (!files.legend.empty()) {
+    eval::write_image_atomically(written.emplace_back(files.legend), flow::color_wheel_legend());
+  }
+  return written;
+}
+
+std::string flow_text(const eval::FlowInput& in, const FlowRun& run,
+                      const std::vector<std::string>& written) {
+  std::string text = "flow " + size_text(in.frame0.size()) + " (" + in.source +
+                     "): " + fixed(run.ms, 2) + " ms, wrote " + joined(written) + "\n";
+  if (run.errors) text += "error vs ground truth: " + eval::errors_text(*run.errors) + "\n";
+  return text;
+}
+
 std::vector<eval::EvalRow> run_eval(const std::vector<eval::EvalPair>& pairs,
                                     const flow::LkParams& params, int threads,
                                     report::HtmlReport* report) {
@@ -41,6 +78,29 @@ std::vector<eval::EvalRow> run_eval(const std::vector<eval::EvalPair>& pairs,
     }
   });
   return rows;
+}
+
+void EvalOutputs::check() const {
+  if (!output.empty()) check_output_path(output, "-o");
+  if (!report.empty()) check_output_path(report, "--report");
+}
+
+std::string run_eval(const std::vector<eval::EvalPair>& pairs, const flow::LkParams& params,
+                     const std::string& preset, int threads, const EvalOutputs& outputs) {
+  std::optional<report::HtmlReport> html;
+  if (!outputs.report.empty()) html.emplace(outputs.title, preset, params);
+  const std::vector<eval::EvalRow> rows = run_eval(pairs, params, threads, html ? &*html : nullptr);
+  const std::string text = outputs.format == "csv"    ? eval::format_csv(rows)
+                           : outputs.format == "json" ? eval::format_json(rows, preset, params)
+                                                      : eval::format_table(rows);
+  if (html) html->write(outputs.report);
+  std::string said = outputs.output.empty() ? text : "";
+  if (!outputs.output.empty()) {
+    write_text_atomically(outputs.output, text);
+    said = "evaluated " + std::to_string(rows.size()) + " pairs, wrote " + outputs.output + "\n";
+  }
+  if (html) said += "wrote report " + outputs.report + "\n";
+  return said;
 }
 
 SweepRunResult run_sweep(const SweepRunOptions& o) {
@@ -66,6 +126,13 @@ SweepRunResult run_sweep(const SweepRunOptions& o) {
     }
   });
   return r;
+}
+
+std::string sweep_text(const SweepRunResult& r, const SweepRunOptions& o) {
+  return eval::sweep_table(r.rows) + "swept " + std::to_string(r.rows.size()) + " values over " +
+         std::to_string(o.pairs.size()) + " pairs, " + std::to_string(o.threads) +
+         " threads, time per pair the fastest of " + std::to_string(o.repeats) +
+         (o.repeats == 1 ? " run" : " runs") + "; wrote " + joined(r.written) + "\n";
 }
 
 }  // namespace roiflow::pipeline

@@ -43,4 +43,9 @@ std::string summary_text(const std::string& what, const TrackSummary& s) {
       s.global_activations, s.lost_frames, s.threads);
 }
 
+std::string summary_text(const DenseSummary& s) {
+  return fmt::format("dense {}: {} pairs in {:.2f} s, {:.1f} pairs/s, {} threads\n", s.input,
+                     s.pairs, s.wall_s, s.fps, s.threads);
+}
+
 }  // namespace roiflow::pipeline

@@ -25,5 +25,7 @@ nlohmann::ordered_json to_json(const DenseSummary& s, const std::string& preset)
 // "<what>: N frames in S s, F fps overall, tracker T fps (M ms/frame, decode excluded), mode m"
 // and "  global activations G, frames lost L, N threads", each ending in '\n'.
 std::string summary_text(const std::string& what, const TrackSummary& s);
+// "dense <input>: N pairs in S s, F pairs/s, T threads\n".
+std::string summary_text(const DenseSummary& s);
 
 }  // namespace roiflow::pipeline

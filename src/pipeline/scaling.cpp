@@ -2,11 +2,14 @@
 
 #include <tbb/global_control.h>
 
+#include <fmt/format.h>
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <set>
 
+#include "core/atomic_write.hpp"
 #include "core/error.hpp"
 #include "pipeline/frame_graph.hpp"
 #include "pipeline/tbb_executor.hpp"
@@ -194,6 +197,24 @@ report::Plot scaling_plot(const ScalingResult& result) {
   gain.series.push_back({"speedup", threads, speedup});
   gain.series.push_back({"ideal", threads, ideal, report::PlotAxis::Left, false});
   return plot;
+}
+
+std::vector<std::string> write_scaling(const ScalingResult& result, const std::string& dir) {
+  const std::string csv = (std::filesystem::path(dir) / "scaling.csv").string();
+  const std::string svg = (std::filesystem::path(dir) / "scaling.svg").string();
+  write_text_atomically(csv, scaling_csv(result));
+  report::write_plot_svg(svg, scaling_plot(result));
+  return {csv, svg};
+}
+
+std::string scaling_text(const ScalingResult& result) {
+  std::string text = fmt::format("scaling {} mode, {}\n", to_string(result.mode), result.input) +
+                     "threads      fps  tracker_fps  speedup  efficiency\n";
+  for (const ScalingRow& row : result.rows) {
+    text += fmt::format("{:7d} {:8.1f} {:12.1f} {:8.2f} {:11.2f}\n", row.threads, row.fps,
+                        row.tracker_fps, row.speedup, row.efficiency);
+  }
+  return text;
 }
 
 }  // namespace roiflow::pipeline

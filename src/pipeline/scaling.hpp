@@ -78,5 +78,9 @@ void fill_speedup(std::vector<ScalingRow>& rows);
 std::string scaling_csv(const ScalingResult& result);
 // Two panels over threads: fps and tracker fps above; speedup (with the ideal line) below.
 report::Plot scaling_plot(const ScalingResult& result);
+// Writes DIR/scaling.csv and DIR/scaling.svg (DIR must exist); returns their paths.
+std::vector<std::string> write_scaling(const ScalingResult& result, const std::string& dir);
+// What `roiflow scaling` prints: the mode and input, then a table of the rows.
+std::string scaling_text(const ScalingResult& result);
 
 }  // namespace roiflow::pipeline

@@ -1,5 +1,6 @@
 #include "stages/box_tracker.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/tracking.hpp>
@@ -7,6 +8,7 @@
 #include <optional>
 
 #include "core/error.hpp"
+#include "core/text.hpp"
 #include "flow/pyramid.hpp"
 
 namespace roiflow::stages {
@@ -146,10 +148,13 @@ std::unique_ptr<BoxTracker> make_box_tracker(std::string_view name, const Tracke
   if (name == "kcf") return std::make_unique<OpenCvBoxTracker>(&create_kcf);
   if (name == "mosse") return std::make_unique<LegacyBoxTracker>(&create_mosse);
   if (name == "medianflow") return std::make_unique<LegacyBoxTracker>(&create_medianflow);
-  std::string known;
-  for (const std::string& n : box_tracker_names())
-    known += (known.empty() ? "" : ", ") + n;
-  throw Error("unknown tracker '" + std::string(name) + "' (known: " + known + ")");
+  throw Error(box_tracker_check(name));
+}
+
+std::string box_tracker_check(std::string_view name) {
+  const std::vector<std::string>& known = box_tracker_names();
+  if (std::find(known.begin(), known.end(), name) != known.end()) return {};
+  return "unknown tracker '" + std::string(name) + "' (known: " + joined(known) + ")";
 }
 
 cv::Mat bgr_picture(const Frame& frame) {

@@ -58,6 +58,9 @@ const std::vector<std::string>& box_tracker_names();
 std::unique_ptr<BoxTracker> make_box_tracker(std::string_view name,
                                              const TrackerParams& roiflow = {});
 
+// "" for a name in box_tracker_names(), else "unknown tracker 'NAME' (known: roiflow,csrt,...)".
+std::string box_tracker_check(std::string_view name);
+
 // The frame's picture as 8-bit BGR (a gray picture converted), a new Mat or the frame's own.
 cv::Mat bgr_picture(const Frame& frame);
 

@@ -1,61 +1,14 @@
-// LocalTracker: the paper's local treatment — one object followed by dense LK on a local region.
+// LocalTracker: the paper's local treatment. One object followed from frame to frame by dense LK
+// on a local region around its predicted position, at the pyramid level of the object's scale,
+// checked forward-backward, corrected against the target's appearance, and declared lost (with
+// a reason) when the measurement cannot be right; docs/LOCAL_TRACKER.md has the details.
 //
 //   using namespace roiflow;
 //   stages::LocalTracker local;                              // paper defaults: ROI 50, LK 10/3/3
-//   local.start({gray0}, {70, 51, 107, 87});                 // appearance captured from frame 0
-//   for (each next frame's 8-bit gray image gray) {
-//     stages::LocalResult r = local.track({gray});           // frame t-1 (kept) -> frame t
-//     if (r.lost) { /* global treatment, then local.restart({gray}, found_box) */ }
-//   }
-//
-// Pyramids: the local treatment builds the pyramids (lk.sigma, the levels LK needs at the
-// object's scale) of only the part of each frame it reads (flow::flow_footprint of the region, the
-// appearance search, a border for the smoothing), on the coarsest level's pixel grid so that they
-// are the whole-frame pyramids' values there. The part built for frame t reaches ahead by the
-// object's velocity, so that the next step finds frame t's part inside it and builds only frame
-// t+1's: one small pyramid per frame instead of a whole one. A whole-frame pyramid given with a
-// frame is used only when the region is the whole frame (whole_frame mode), where it is the same
-// pyramid; so the result never depends on whether one was given.
-//
-// Object scale: LK (forward and backward) runs on the finest pyramid level where the object's
-// shorter side still spans `lk_patches` LK patches (20 pixels at the paper's 10x10), up to
-// the same coarsest level (at least two levels), and its flow is upsampled to full resolution
-// (flow::FlowOptions::finest_level): a 90-pixel object costs what a 45-pixel one does, at a
-// precision of a fraction of that level's pixel. Patches mostly inside the object are what LK
-// needs: on Car4, 1.6 to 3.2 patches track alike (AUC 0.866-0.875), 1.2 loses the car.
-//
-// Per frame: the box of frame t-1 and the box the constant-velocity prediction puts in frame t
-// span the local region (at least roi x roi, centred on them). Dense LK runs forward over the
-// region, seeded with the predicted velocity, and backward around where the object went, seeded
-// with the reverse of its rough motion; the object's pixels (a grid over its box) whose
-// forward-backward error stays under `fb_threshold` give its motion (median flow), and those of
-// them that also move with that median (up to what a scale change allows) give its scale change
-// (median ratio of distances between pairs of them). That measurement is then corrected against
-// the target's appearance: the template captured by start() is matched (zero-mean NCC) at
-// 2 * scale_steps + 1 scales around the measured box, on the pyramid level where the object is
-// about `match_side` pixels across, and when the match is good the box moves part of the way
-// (`appearance_weight`) to it. That first appearance does not drift, so it pulls back the error
-// that chained flow accumulates, while flow keeps the box smooth where a lone match would jitter.
-// While the first appearance matches poorly (lighting, pose), a recent one, refreshed every
-// `template_interval` confidently tracked frames, stands in. Finally the velocity is corrected
-// by the measured displacement (an alpha-beta filter with alpha = 1: the reported box is the
-// measurement).
-//
-// Self-awareness (docs/TRACKING.md): the object's motion comes from the pixels that move unlike
-// the background (measured on a ring around the box), and the step checks for states that cannot
-// be right — a forward-backward error that is high, a size change no object makes, a box as large
-// as the frame, a box that moves with the background right after the target moved unlike it, a
-// look that matches none of the target's (first, recent, remembered) — and declares the target
-// lost (LostReason says which). While lost, the box follows the flow where it holds (else it
-// coasts) and the appearance is searched over a widening window around it; only a confident match
-// takes the target back.
-//
-// The object is lost when too few of its pixels pass the forward-backward check or its box has
-// too little texture (unless the appearance, searched over twice the radius around the
-// prediction, still matches well: a sudden change of lighting breaks LK's brightness constancy,
-// not the object's look), when its appearance no longer matches, or when it leaves the local
-// region. A lost result carries the predicted box; the state moves to that prediction, so the
-// next call searches where the object should be (coasting) until restart() places it again.
+//   local.start({frame_t, nullptr}, {70, 51, 107, 87});     // appearance captured from frame t
+//   const stages::LocalResult r = local.track({frame_t1, nullptr});  // frame t -> frame t+1
+//   if (r.lost) local.restart({frame_t1, nullptr}, r.box);  // where the global treatment found it
+//   std::cout << r.box << " moved " << r.velocity << " px\n";
 #pragma once
 
 #include <memory>

@@ -1,35 +1,22 @@
-// Tracker: the paper's system for one object — local treatment with a global fallback.
+// Tracker: the paper's system for one object. The local treatment (LocalTracker) follows the
+// target while it is found; the global treatment (GlobalDetector) finds a moving object when
+// none is known or the target is lost; global mode (the paper's baseline) runs LK over the
+// whole frame every frame. docs/LOCAL_TRACKER.md describes a frame's steps.
 //
 //   using namespace roiflow;
 //   stages::TrackerParams params;                    // paper defaults: ROI 50, LK 10x10/3/3
 //   params.init = cv::Rect2f(70, 51, 107, 87);       // OTB protocol; leave empty to detect
 //   stages::Tracker tracker(params);
-//   while (auto f = source.next()) {
-//     std::shared_ptr<flow::Pyramid> pyr;                   // optional: see wants_pyramid()
-//     if (tracker.wants_pyramid()) pyr = std::make_shared<flow::Pyramid>(flow::build_pyramid(
-//         f->gray, tracker.pyramid_levels(), tracker.pyramid_sigma()));
-//     stages::TrackerOutput out =
-//         tracker.process({f->index, f->image, f->gray, pyr, f->deferred_image});
-//     if (out.has_target) log.write(to_record(out));
+//   stages::VideoSource source("car.mp4");
+//   while (std::optional<stages::Frame> f = source.next()) {
+//     stages::TrackerInput in{f->index, f->image, f->gray, nullptr, f->deferred_image};
+//     if (tracker.wants_pyramid()) {                 // optional: a pyramid built outside
+//       in.pyramid = std::make_shared<flow::Pyramid>(
+//           flow::build_pyramid(f->gray, tracker.pyramid_levels(), tracker.pyramid_sigma()));
+//     }
+//     const stages::TrackerOutput out = tracker.process(in);
+//     if (out.has_target) std::cout << eval::track_csv_row(out.record());
 //   }
-//
-// Per frame, in order:
-//  - no target yet: the global treatment (GlobalDetector) looks for a moving object (fixed
-//    camera) and, once found, the target's box, appearance and signature are captured; with
-//    `init` the target is known from the first frame.
-//  - local mode: dense LK on the pyramids of frames t-1 and t, only inside the local region
-//    (at least roi x roi, larger for a large object) placed where the prediction puts the object;
-//    robust object motion (median flow of the object's pixels that pass a forward-backward
-//    check), scale change from point spreads, a correction of the measurement against the
-//    target's appearance, and a constant-velocity prediction corrected by the measurement
-//    (paper Fig. 3) that places the region for the next frame.
-//  - the decision: the object stays found while enough of its pixels pass the
-//    forward-backward check, it has texture, its appearance still matches and it stays inside
-//    its region; otherwise it is lost and the global treatment runs (counted in
-//    global_activations) until it is found again; between, the box coasts on the prediction
-//    and is reported lost.
-//  - global mode (the paper's baseline): the same estimator, but LK runs over the whole frame
-//    every frame and every frame counts as a global activation.
 #pragma once
 
 #include <memory>

@@ -97,7 +97,7 @@ TEST_F(BenchmarkCliTest, BadInputFailsWithOneLineAndNoOutput) {
       {{"benchmark", path("empty"), "--out", out}, 1, "holds no sequence"},
       {{"benchmark", path("set"), "--out", out, "--trackers", "roiflow,tld"},
        2,
-       "--trackers: unknown tracker 'tld' (known: roiflow,csrt,kcf,mosse,medianflow)"},
+       "--trackers: unknown tracker 'tld' (known: roiflow, csrt, kcf, mosse, medianflow)"},
       {{"benchmark", path("set"), "--out", out, "--trackers", "csrt,csrt"}, 1, "listed twice"},
       {{"benchmark", path("set"), "--out", out, "--sequences", "gamma"}, 1, "no sequence 'gamma'"},
       {{"benchmark", path("wrong"), "--out", out}, 1, "holds 6 boxes but the sequence has 5"},

@@ -87,6 +87,24 @@ TEST(Scaling, CsvAndPlot) {
   EXPECT_NE(report::plot_svg(plot).find("speedup"), std::string::npos);
 }
 
+class ScalingFiles : public test::TempDirTest {};
+
+TEST_F(ScalingFiles, TextTableAndTheTwoFiles) {
+  ScalingResult r;
+  r.input = "clip";
+  r.mode = ScalingMode::Dense;
+  r.rows = {{1, 10, 1.0, 10.0, 50.0, 1.0, 1.0}, {2, 10, 0.6, 16.666, 95.5, 1.6666, 0.8333}};
+  EXPECT_EQ(pipeline::scaling_text(r),
+            "scaling dense mode, clip\n"
+            "threads      fps  tracker_fps  speedup  efficiency\n"
+            "      1     10.0         50.0     1.00        1.00\n"
+            "      2     16.7         95.5     1.67        0.83\n");
+  const std::vector<std::string> written = pipeline::write_scaling(r, dir_.string());
+  ASSERT_EQ(written, (std::vector<std::string>{path("scaling.csv"), path("scaling.svg")}));
+  EXPECT_EQ(test::read_text(written[0]), pipeline::scaling_csv(r));
+  EXPECT_NE(test::read_text(written[1]).find("<svg"), std::string::npos);
+}
+
 TEST(Scaling, BadOptionsThrow) {
   const auto fails = [](ScalingOptions o, const std::string& expected) {
     const std::string message = test::error_message([&] { pipeline::run_scaling(o); });
