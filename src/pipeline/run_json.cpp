@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include "core/atomic_write.hpp"
+#include "core/text.hpp"
+
 namespace roiflow::pipeline {
 
 nlohmann::ordered_json to_json(const TrackSummary& s) {
@@ -46,6 +49,15 @@ std::string summary_text(const std::string& what, const TrackSummary& s) {
 std::string summary_text(const DenseSummary& s) {
   return fmt::format("dense {}: {} pairs in {:.2f} s, {:.1f} pairs/s, {} threads\n", s.input,
                      s.pairs, s.wall_s, s.fps, s.threads);
+}
+
+std::string finish_run(const std::string& summary, const nlohmann::ordered_json& doc,
+                       const std::string& text, std::vector<std::string> written) {
+  if (!summary.empty()) {
+    write_text_atomically(summary, doc.dump(2) + "\n");
+    written.push_back(summary);
+  }
+  return text + (written.empty() ? "" : "  wrote " + joined(written) + "\n");
 }
 
 }  // namespace roiflow::pipeline

@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "pipeline/run.hpp"
 
@@ -27,5 +28,9 @@ nlohmann::ordered_json to_json(const DenseSummary& s, const std::string& preset)
 std::string summary_text(const std::string& what, const TrackSummary& s);
 // "dense <input>: N pairs in S s, F pairs/s, T threads\n".
 std::string summary_text(const DenseSummary& s);
+// The end of a run command: writes `doc` to `summary` when one is named, and returns what the
+// command prints, `text` then "  wrote FILES" (`written`, then the summary; no line for none).
+std::string finish_run(const std::string& summary, const nlohmann::ordered_json& doc,
+                       const std::string& text, std::vector<std::string> written);
 
 }  // namespace roiflow::pipeline
