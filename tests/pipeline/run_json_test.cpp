@@ -23,6 +23,41 @@ TEST_F(RunJson, FinishRunWritesTheSummaryAndListsWhatWasWritten) {
   EXPECT_EQ(pipeline::finish_run(path("s.json"), doc, "t\n", {"a.csv"}),
             "t\n  wrote a.csv, " + path("s.json") + "\n");
   EXPECT_EQ(nlohmann::json::parse(test::read_text(path("s.json"))).at("frames"), 12);
+  EXPECT_EQ(pipeline::finish_run("", doc, "t\n", {"", "b.avi", ""}), "t\n  wrote b.avi\n");
+}
+
+TEST_F(RunJson, TrackSummaryDocumentSaysHowTheRunEnded) {
+  pipeline::TrackSummary s;
+  s.input = "clip.avi";
+  s.status = "end of stream";
+  s.frames = 5;
+  nlohmann::ordered_json doc = pipeline::summary_json(s, {});
+  EXPECT_EQ(doc.at("input"), "clip.avi");
+  EXPECT_EQ(doc.at("status"), "end of stream");
+  EXPECT_EQ(doc.at("frames"), 5);
+  doc = pipeline::summary_json(s, {1, "input stopped at frame 5"});
+  EXPECT_EQ(doc.at("status"), "input stopped at frame 5");
+}
+
+TEST_F(RunJson, TrackOutputsAreCheckedByOption) {
+  pipeline::check_track_outputs(path("t.csv"), path("v.avi"), path("s.json"), path("m.txt"));
+  pipeline::check_track_outputs("", "", "");
+  const std::string missing = path("no/such/dir/x");
+  EXPECT_NE(test::error_message([&] {
+              pipeline::check_track_outputs(missing + ".csv", "", "");
+            }).find("--log"),
+            std::string::npos);
+  EXPECT_NE(test::error_message([&] {
+              pipeline::check_track_outputs("", "", "", missing);
+            }).find("--mot"),
+            std::string::npos);
+  EXPECT_NE(
+      test::error_message([&] { pipeline::check_track_outputs("", missing, ""); }).find("--out"),
+      std::string::npos);
+  EXPECT_NE(test::error_message([&] {
+              pipeline::check_track_outputs("", "", missing);
+            }).find("--summary"),
+            std::string::npos);
 }
 
 TEST(RunText, DenseSummaryLine) {
