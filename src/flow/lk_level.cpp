@@ -144,7 +144,7 @@ void fill_input_row(void* context, int row, float* u, float* v) {
 
 // Final rows of each band, each starting on a stripe row. A band below the first recomputes the
 // rows its earlier iterations read above it: two bands are split where their work (rows times
-// iterations) is the most even; more bands about equally.
+// iterations, by LkKernels::band_rows's weights) is the most even; more bands about equally.
 std::vector<int> band_starts(const LkKernels& k, const LevelJob& L, int iterations, int wanted) {
   const int h = L.h;
   const int bands = std::clamp(h / kMinBandRows, 1, std::max(1, wanted));
