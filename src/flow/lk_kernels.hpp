@@ -5,7 +5,7 @@
 // that no inline function is compiled with two instruction sets.
 //
 //   const roiflow::flow::detail::LkKernels& k = roiflow::flow::detail::lk_kernels();
-//   const int lanes = k.lanes;  // 16 with AVX-512 ("avx512" == k.name), 8 with AVX2, 4 else
+//   std::cout << k.name << ": " << k.lanes << " lanes\n";  // 16 with AVX-512, 8 with AVX2, 4 else
 #pragma once
 
 #include <cstddef>

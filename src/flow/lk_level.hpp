@@ -6,6 +6,7 @@
 //   using namespace roiflow::flow::detail;
 //   const Window w = make_window(10, /*half_pixel_grid=*/true);  // Horn–Schunck: lo -5, hi 4
 //   LevelScratch scratch;  // band buffers, kept across levels and calls by iterate_level
+//   std::cout << "reach " << w.reach() << " px, scratch " << scratch.bytes() << " bytes\n";
 #pragma once
 
 #include <cstddef>
