@@ -1,5 +1,4 @@
-// roiflow batch: many videos, one output folder each, several at once (pipeline/batch.hpp), e.g.
-// `roiflow batch videos/ --out out/batch -- track --roi 60`.
+// roiflow batch videos/ --out out/batch -- track --roi 60: many videos, several at once.
 #include <filesystem>
 #include <iostream>
 

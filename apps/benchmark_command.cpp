@@ -1,5 +1,4 @@
-// roiflow benchmark: OTB one-pass evaluation of roiflow and OpenCV's trackers over every sequence
-// of a folder, in one run (pipeline/benchmark.hpp).
+// roiflow benchmark: OTB one-pass evaluation of several trackers (pipeline/benchmark.hpp).
 #include <iostream>
 
 #include "cli_common.hpp"
@@ -21,10 +20,8 @@ void add_benchmark_command(CLI::App& app, int& /*exit_code*/) {
   sub->add_option("DIR", run.dir,
                   "OTB-layout folder, <seq>/img/*.jpg and <seq>/groundtruth_rect.txt (NaN "
                   "lines not scored), or one sequence folder (docs/BENCHMARK.md)")
-      ->type_name("DIR")
       ->required();
   sub->add_option("--out", out, "folder for benchmark.md/.csv, success.svg, precision.svg")
-      ->type_name("DIR")
       ->required();
   sub->add_option("--trackers", run.trackers, "trackers to run, in the order to report")
       ->type_name("LIST")
@@ -32,11 +29,8 @@ void add_benchmark_command(CLI::App& app, int& /*exit_code*/) {
       ->check([](const std::string& t) { return stages::box_tracker_check(t); })
       ->capture_default_str();
   sub->add_option("--sequences", run.sequences, "only these sequences (folder names)")
-      ->type_name("LIST")
       ->delimiter(',');
-  sub->add_option("--max-frames", run.max_frames,
-                  "at most N frames of each sequence, scored as a prefix (0 = all)")
-      ->type_name("N")
+  sub->add_option("--max-frames", run.max_frames, "at most N frames of each sequence (0 = all)")
       ->check(CLI::Range(0LL, 1000000000LL));
   add_tracker_options(*sub, run.roiflow, nullptr, "roiflow: ");
   sub->add_flag("--tracks", tracks,

@@ -64,8 +64,7 @@ void add_run_outputs(CLI::App& sub, std::string& video, std::string& summary, bo
                      const std::string& video_help) {
   progress = true;
   sub.add_option("--out", video, video_help)->type_name("VIDEO|DIR");
-  sub.add_option("--summary", summary, "run summary (frames, fps per stage, ...) as JSON")
-      ->type_name("JSON");
+  sub.add_option("--summary", summary, "run summary (frames, fps per stage, ...), JSON");
   sub.add_flag("!--no-progress", progress, "no progress bar on the terminal");
 }
 
@@ -87,15 +86,11 @@ void add_tracker_options(CLI::App& sub, stages::TrackerParams& tracker, std::str
       ->check(CLI::Range(8, 4096))
       ->capture_default_str();
   sub.add_option("--lk-patches", tracker.local.lk_patches,
-                 who +
-                     "LK runs on the coarsest pyramid level where the object's shorter side "
-                     "spans this many LK patches (0 = always full resolution)")
+                 who + "LK on the coarsest level where the object spans this many LK patches")
       ->check(CLI::Range(0.0, 100.0))
       ->capture_default_str();
   if (mode == nullptr) return;
-  sub.add_option("--mode", *mode,
-                 "local: LK in the local region, global fallback; global: the "
-                 "whole frame every frame (the paper's baseline)")
+  sub.add_option("--mode", *mode, "local: LK in a local region; global: in the whole frame")
       ->check(CLI::IsMember({"local", "global"}))
       ->capture_default_str();
 }
@@ -105,8 +100,7 @@ void add_source_options(CLI::App& sub, pipeline::SourceOptions& source, int& in_
       ->check(CLI::Range(0LL, std::numeric_limits<long long>::max()));
   sub.add_option("--max-frames", source.max_frames, "stop after this many frames (0 = all)")
       ->check(CLI::Range(0LL, std::numeric_limits<long long>::max()));
-  sub.add_option("--in-flight", in_flight,
-                 "frames decoded ahead and in the pipeline at most (0 = 2 x threads + 2)")
+  sub.add_option("--in-flight", in_flight, "frames in the pipeline at most (0 = 2 x threads + 2)")
       ->check(CLI::Range(0, 1024));
   sub.add_option("--decode-threads", source.decode_threads,
                  "FFmpeg decoder threads (0 = one up to 1280x720, else FFmpeg's choice)")

@@ -28,13 +28,14 @@ void add_lk_options(CLI::App& cmd, LkOptions& lk);
 // The preset with the overrides applied; out-of-range values throw UsageError.
 flow::LkParams lk_params(const LkOptions& lk);
 
-// Runs `check` (a validate()): its roiflow::Error becomes a UsageError (exit code 2).
+// Runs `check` (a validate(), a parse): its roiflow::Error becomes a UsageError (exit code 2),
+// its message after `prefix`.
 template <class Check>
-void as_usage(Check&& check) {
+void as_usage(Check&& check, const std::string& prefix = "") {
   try {
     check();
   } catch (const Error& e) {
-    throw UsageError(e.what());
+    throw UsageError(prefix + e.what());
   }
 }
 

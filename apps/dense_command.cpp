@@ -2,7 +2,6 @@
 #include <iostream>
 
 #include "cli_common.hpp"
-#include "core/atomic_write.hpp"
 #include "pipeline/run_json.hpp"
 
 namespace roiflow::cli {
@@ -46,11 +45,8 @@ void add_dense_command(CLI::App& app, int& exit_code) {
     pipeline::DenseSummary s = pipeline::run_dense_video(video, o);
     const pipeline::Ending end = pipeline::ending(s.end, s.frames, s.status);
     if (!end.message.empty()) s.status = end.message;
-    if (!summary.empty()) {
-      write_text_atomically(summary, pipeline::to_json(s, lk.preset).dump(2) + "\n");
-    }
-    std::cout << pipeline::summary_text(s) << "  wrote " << s.outputs
-              << (summary.empty() ? "" : ", " + summary) << "\n";
+    std::cout << pipeline::finish_run(summary, pipeline::to_json(s, lk.preset),
+                                      pipeline::summary_text(s), {s.outputs});
     exit_code = run_end(end);
   });
 }

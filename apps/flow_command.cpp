@@ -1,5 +1,4 @@
-// roiflow flow: dense flow of one image pair (or a synthetic one) to a .flo file
-// (pipeline::run_flow).
+// roiflow flow: dense flow of one image pair (or a synthetic one) to a .flo file.
 #include <iostream>
 
 #include "cli_common.hpp"

@@ -1,8 +1,6 @@
-// roiflow, the command-line tool: one git-style subcommand per job, each in
-// apps/<name>_command.cpp (CLI11 parses, the library computes, the command prints). Failures
-// print one line, `roiflow: error: <message>`, on stderr: exit code 2 for a bad command line
-// (UsageError included), 1 for anything that fails at run time. Inputs and output locations are
-// checked before any computation and outputs are written atomically: a failed run leaves none.
+// roiflow, the command-line tool: one subcommand per apps/<name>_command.cpp. A failure prints
+// one line, `roiflow: error: <message>`, on stderr: exit code 2 for a bad command line (UsageError
+// included), 1 at run time. Outputs are checked before any work and written atomically.
 #include <CLI/CLI.hpp>
 #include <cstdlib>
 #include <iostream>

@@ -1,5 +1,4 @@
-// roiflow scaling: the same run at several thread counts; fps, speedup and efficiency as a table,
-// scaling.csv and scaling.svg (pipeline/scaling.hpp).
+// roiflow scaling: one run at several thread counts; fps, speedup, efficiency (pipeline/scaling).
 #include <iostream>
 
 #include "cli_common.hpp"

@@ -1,5 +1,4 @@
-// roiflow score: OTB one-pass metrics of a track log against ground-truth boxes, or CLEAR-MOT and
-// IDF1 of a multi-object track (eval/score_text.hpp).
+// roiflow score: OTB metrics of a track log, or CLEAR-MOT and IDF1 (eval/score_text.hpp).
 #include <iostream>
 
 #include "cli_common.hpp"

@@ -1,5 +1,4 @@
-// roiflow sweep: error and run time of dense LK as one parameter varies (paper Fig. 7, 8):
-// sweep.csv and one <param>.svg (pipeline::run_sweep).
+// roiflow sweep: error and time of dense LK as one parameter varies (pipeline::run_sweep).
 #include <filesystem>
 #include <iostream>
 

@@ -201,11 +201,17 @@ class CriticalPathExecutor final : public roiflow::Executor {
       longest = std::max(longest, t);
     }
     saved_s_ += sum - std::max(longest, sum / lanes_);
+    inside_s_ += sum;
+    uneven_s_ += std::max(longest, sum / lanes_) - sum / lanes_;
   }
   int concurrency() const override { return lanes_; }
   // CPU seconds the schedule would not take on `lanes` threads, since the last reset.
   double saved_s() const { return saved_s_; }
-  void reset() { saved_s_ = 0; }
+  // CPU seconds inside the parallel regions, and what their uneven chunks add to the schedule
+  // beyond an even split, since the last reset.
+  double inside_s() const { return inside_s_; }
+  double uneven_s() const { return uneven_s_; }
+  void reset() { saved_s_ = inside_s_ = uneven_s_ = 0; }
 
   static double thread_cpu_s() {
     timespec ts{};
@@ -216,12 +222,15 @@ class CriticalPathExecutor final : public roiflow::Executor {
  private:
   int lanes_;
   mutable double saved_s_ = 0;
+  mutable double inside_s_ = 0;
+  mutable double uneven_s_ = 0;
 };
 
 // BM_TwoThreadBound/<preset>/<W>x<H>: counters t1_ms (one pair on one thread, CPU time),
 // work2_ms (the two-thread schedule's total CPU time: its bands recompute some rows),
 // critical2_ms (what two threads would take, see CriticalPathExecutor) and speedup2 = t1_ms /
-// critical2_ms.
+// critical2_ms; critical2_ms = serial2_ms (the work outside the parallel regions) + half of the
+// work inside them + uneven2_ms (what their chunks' imbalance adds).
 void bm_two_thread_bound(benchmark::State& state, roiflow::flow::LkParams params, cv::Size size) {
   const Scene& scene = scene_of(size);
   roiflow::pipeline::run_with_threads(1, [&] {
@@ -230,7 +239,7 @@ void bm_two_thread_bound(benchmark::State& state, roiflow::flow::LkParams params
     roiflow::flow::FlowResult a, b;
     serial.calc(scene.frame0, scene.frame1, a);
     split.calc(scene.frame0, scene.frame1, b);
-    double t1 = 0, work2 = 0, critical2 = 0;
+    double t1 = 0, work2 = 0, critical2 = 0, serial2 = 0, uneven2 = 0;
     for (auto _ : state) {
       double t0 = CriticalPathExecutor::thread_cpu_s();
       serial.calc(scene.frame0, scene.frame1, a);
@@ -241,6 +250,8 @@ void bm_two_thread_bound(benchmark::State& state, roiflow::flow::LkParams params
       const double w = CriticalPathExecutor::thread_cpu_s() - t0;
       work2 += w;
       critical2 += w - two.saved_s();
+      serial2 += w - two.inside_s();
+      uneven2 += two.uneven_s();
     }
     if (cv::norm(a.flow, b.flow, cv::NORM_INF) != 0.0) state.SkipWithError("flows differ");
     const double n = static_cast<double>(state.iterations());
@@ -248,6 +259,8 @@ void bm_two_thread_bound(benchmark::State& state, roiflow::flow::LkParams params
     state.counters["work2_ms"] = 1e3 * work2 / n;
     state.counters["critical2_ms"] = 1e3 * critical2 / n;
     state.counters["speedup2"] = t1 / critical2;
+    state.counters["serial2_ms"] = 1e3 * serial2 / n;
+    state.counters["uneven2_ms"] = 1e3 * uneven2 / n;
   });
 }
 

@@ -9,11 +9,8 @@
 # executable against that part only (an example cannot use a part above its header's); they are
 # built with everything else and never run.
 #
-# A header without an example fails the build, except the internal ones (*_impl.hpp and the flow
-# core's kernels and level internals, not meant for users).
-cmake_policy(SET CMP0057 NEW)  # if(IN_LIST) in script mode too
-set(ROIFLOW_EXAMPLE_INTERNAL simd.hpp lk_kernels.hpp lk_band_impl.hpp lk_kernels_impl.hpp
-                             lk_rows_impl.hpp lk_level.hpp window_cost.hpp)
+# A header without an example fails the build, except the internal ones (*_impl.hpp, not meant
+# for users).
 
 if(CMAKE_SCRIPT_MODE_FILE)
   # cmake -DSOURCE_DIR=... -Dpart=... -Dsource=... -P header_examples.cmake: writes `source`.
@@ -24,7 +21,7 @@ if(CMAKE_SCRIPT_MODE_FILE)
   foreach(header ${headers})
     get_filename_component(file ${header} NAME)
     get_filename_component(name ${header} NAME_WE)
-    if(file IN_LIST ROIFLOW_EXAMPLE_INTERNAL OR file MATCHES "_impl\\.hpp$")
+    if(file MATCHES "_impl\\.hpp$")
       continue()
     endif()
     # Semicolons and brackets would split the lines (a CMake list): they travel as placeholders.

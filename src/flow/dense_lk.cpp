@@ -45,10 +45,15 @@ cv::Rect expand(const cv::Rect& r, int by) {
   return {r.x - by, r.y - by, r.width + 2 * by, r.height + 2 * by};
 }
 
-void median_filter(cv::Mat& u, cv::Mat& v, int ksize) {
+void median_filter(cv::Mat& u, cv::Mat& v, int ksize, const Executor& exec) {
   if (ksize <= 1) return;
-  cv::medianBlur(u, u, ksize);
-  cv::medianBlur(v, v, ksize);
+  // The two components side by side.
+  exec.for_range(0, 2, 1, [&](int b0, int b1) {
+    for (int b = b0; b < b1; ++b) {
+      cv::Mat& m = b == 0 ? u : v;
+      cv::medianBlur(m, m, ksize);
+    }
+  });
 }
 
 // Which levels LK runs on and the rectangle each level computes (coarsest last).
@@ -96,15 +101,15 @@ LevelPlan plan_levels(cv::Size size, const LkParams& params, const FlowOptions& 
 }
 
 // `src` (the finest level's confidence over rectangle `from` of level `level`) sampled at the
-// nearest level pixel for every level-0 pixel of `region`.
+// nearest level pixel for the level-0 pixels of `region` in rows [y0, y1) of `out` (region-sized,
+// made by the caller).
 void confidence_to_level0(const cv::Mat& src, const cv::Rect& from, int level,
-                          const cv::Rect& region, cv::Mat& out) {
-  out.create(region.size(), CV_32F);
+                          const cv::Rect& region, cv::Mat& out, int y0, int y1) {
   const int half = level > 0 ? 1 << (level - 1) : 0;
   std::vector<int> column(region.width);
   for (int x = 0; x < region.width; ++x)
     column[x] = std::clamp(((region.x + x + half) >> level) - from.x, 0, src.cols - 1);
-  for (int y = 0; y < region.height; ++y) {
+  for (int y = y0; y < y1; ++y) {
     const int sy = std::clamp(((region.y + y + half) >> level) - from.y, 0, src.rows - 1);
     const float* in = src.ptr<float>(sy);
     float* o = out.ptr<float>(y);
@@ -206,8 +211,8 @@ void flow_from_pyramids(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkPar
   for (int l = levels - 1; l >= 0; --l) {
     const cv::Rect& c = comp[l];
     if (l < plan.finest) {  // below the finest level the flow is only upsampled
-      upsample_flow(view(ws.u[l + 1], comp[l + 1].size()), comp[l + 1].tl(), c, ws.u[l]);
-      upsample_flow(view(ws.v[l + 1], comp[l + 1].size()), comp[l + 1].tl(), c, ws.v[l]);
+      upsample_flow(view(ws.u[l + 1], comp[l + 1].size()), comp[l + 1].tl(), c, ws.u[l], &exec);
+      upsample_flow(view(ws.v[l + 1], comp[l + 1].size()), comp[l + 1].tl(), c, ws.v[l], &exec);
       continue;
     }
     cv::Mat coarse_u, coarse_v;  // LevelInput points at these
@@ -236,7 +241,7 @@ void flow_from_pyramids(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkPar
     iterate_level(p, input, ws.u[l], ws.v[l], finest ? &ws.confidence : nullptr, params.iterations,
                   exec, ws.scratch);
     cv::Mat u = view(ws.u[l], c.size()), v = view(ws.v[l], c.size());
-    median_filter(u, v, finest ? params.final_median : params.level_median);
+    median_filter(u, v, finest ? params.final_median : params.level_median, exec);
   }
 
   const cv::Rect crop(region.tl() - comp[0].tl(), region.size());
@@ -244,9 +249,15 @@ void flow_from_pyramids(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkPar
   const cv::Mat confidence = view(ws.confidence, comp[plan.finest].size());
   result.flow.create(crop.size(), CV_32FC2);
   if (plan.finest > 0) {
-    const cv::Mat planes[] = {u, v};
-    cv::merge(planes, 2, result.flow);
-    confidence_to_level0(confidence, comp[plan.finest], plan.finest, region, result.confidence);
+    result.confidence.create(crop.size(), CV_32F);
+    exec.for_range(0, crop.height, 64, [&](int y0, int y1) {
+      const cv::Rect rows(0, y0, crop.width, y1 - y0);
+      const cv::Mat planes[] = {u(rows), v(rows)};
+      cv::Mat out = result.flow(rows);
+      cv::merge(planes, 2, out);
+      confidence_to_level0(confidence, comp[plan.finest], plan.finest, region, result.confidence,
+                           y0, y1);
+    });
   } else {
     result.confidence.create(crop.size(), CV_32F);
     // Row blocks on the executor: at VGA these copies are a few per cent of a pair.

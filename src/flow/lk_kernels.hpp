@@ -5,7 +5,7 @@
 // that no inline function is compiled with two instruction sets.
 //
 //   const roiflow::flow::detail::LkKernels& k = roiflow::flow::detail::lk_kernels();
-//   const int lanes = k.lanes;  // 16 with AVX-512 ("avx512" == k.name), 8 with AVX2, 4 else
+//   std::cout << k.name << ": " << k.lanes << " lanes\n";  // 16 with AVX-512, 8 with AVX2, 4 else
 #pragma once
 
 #include <cstddef>
@@ -90,7 +90,8 @@ struct LkKernels {
   void (*run_band)(const BandJob& job);
   // The rows iteration 0 reads for final rows [begin, end).
   RowSpan (*input_rows)(const LevelJob& level, int iterations, int begin, int end);
-  // The rows all iterations of run_band compute for final rows [begin, end), added up.
+  // The work of run_band for final rows [begin, end): the rows all iterations compute, each
+  // weighted by what it costs (a row solved 9, a row that only enters the window 5).
   int (*band_rows)(const LevelJob& level, int iterations, int begin, int end);
   // A row of the finer level's flow component upsampled x2 from coarse rows a and b (blended by
   // fy in {0, 1/2}), n coarse pixels, starting at coarse pixel k0 (between k0 and k0 + 1 when

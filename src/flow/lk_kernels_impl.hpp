@@ -296,8 +296,8 @@ void enter_row_t(int x0, int x1, const TermRows& rows, float inv_s2_value, float
 }
 
 // Fresh window sums: acc = the window's ring rows added top to bottom (then their prefix sums as
-// in enter_row). A running sum's rounding depends on where it started: summing afresh every
-// `stripe` rows makes every row independent of where its pass began.
+// in enter_row, unless `prefix` is null). A running sum's rounding depends on where it started:
+// summing afresh every `stripe` rows makes every row independent of where its pass began.
 void resum_row(int x0, int x1, const float* const* row_list, int count, float* acc,
                const float* top, const float* bot, float* col, Idx col_stride, float* prefix,
                Idx pstride, float* carry_mem) {
@@ -315,6 +315,7 @@ void resum_row(int x0, int x1, const float* const* row_list, int count, float* a
       for (int r = 1; r < count; ++r)
         sum = S::add(sum, S::load(at(rows[r], x, c)));
       S::store(at(acc, x, c), sum);
+      if (!prefix) continue;
       if (top) {
         prefix_out<true>(sum, S::load(at(bot, x, c)), top, x, c, col, col_stride, prefix, pstride,
                          carry[c]);

@@ -144,7 +144,7 @@ void fill_input_row(void* context, int row, float* u, float* v) {
 
 // Final rows of each band, each starting on a stripe row. A band below the first recomputes the
 // rows its earlier iterations read above it: two bands are split where their work (rows times
-// iterations) is the most even; more bands about equally.
+// iterations, by LkKernels::band_rows's weights) is the most even; more bands about equally.
 std::vector<int> band_starts(const LkKernels& k, const LevelJob& L, int iterations, int wanted) {
   const int h = L.h;
   const int bands = std::clamp(h / kMinBandRows, 1, std::max(1, wanted));
@@ -288,12 +288,20 @@ void iterate_level(const LevelProblem& p, const LevelInput& input, cv::Mat& u, c
   }
 }
 
-void upsample_flow(const cv::Mat& src, cv::Point src_origin, const cv::Rect& dst, cv::Mat& out) {
+void upsample_flow(const cv::Mat& src, cv::Point src_origin, const cv::Rect& dst, cv::Mat& out,
+                   const Executor* executor) {
   out.create(dst.size(), CV_32F);
   const LkKernels& k = lk_kernels();
-  std::vector<float> temp(upsample_temp_floats(src.cols));
-  for (int y = 0; y < dst.height; ++y)
-    upsample_row(k, src, src_origin, dst, y, temp.data(), out.ptr<float>(y));
+  auto rows = [&](int y0, int y1) {
+    std::vector<float> temp(upsample_temp_floats(src.cols));
+    for (int y = y0; y < y1; ++y)
+      upsample_row(k, src, src_origin, dst, y, temp.data(), out.ptr<float>(y));
+  };
+  if (executor && executor->concurrency() > 1) {
+    executor->for_range(0, dst.height, kMinBandRows, rows);
+  } else {
+    rows(0, dst.height);
+  }
 }
 
 }  // namespace roiflow::flow::detail

@@ -6,6 +6,7 @@
 //   using namespace roiflow::flow::detail;
 //   const Window w = make_window(10, /*half_pixel_grid=*/true);  // Horn–Schunck: lo -5, hi 4
 //   LevelScratch scratch;  // band buffers, kept across levels and calls by iterate_level
+//   std::cout << "reach " << w.reach() << " px, scratch " << scratch.bytes() << " bytes\n";
 #pragma once
 
 #include <cstddef>
@@ -94,7 +95,9 @@ void iterate_level(const LevelProblem& p, const LevelInput& input, cv::Mat& u, c
                    LevelScratch& scratch, cv::Mat* flow = nullptr);
 
 // Flow component of the coarser level (origin `src_origin` in its level) resampled onto
-// rectangle `dst` of the finer level and doubled.
-void upsample_flow(const cv::Mat& src, cv::Point src_origin, const cv::Rect& dst, cv::Mat& out);
+// rectangle `dst` of the finer level and doubled; blocks of rows on `executor` when given (the
+// rows are independent: the same result for any split).
+void upsample_flow(const cv::Mat& src, cv::Point src_origin, const cv::Rect& dst, cv::Mat& out,
+                   const Executor* executor = nullptr);
 
 }  // namespace roiflow::flow::detail

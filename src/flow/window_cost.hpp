@@ -1,9 +1,15 @@
 // The zero-mean SSD of windows over small images, streamed row by row (internal to
 // roiflow::flow: the coarse search and the candidate fusion of large_motion.hpp).
 //
-//   detail::StreamingZssd z(w, h, 7);
-//   detail::for_each_cost_row(z, [&](int y, float* d) { /* row y of the differences */ },
-//                             [&](int y, const float* cost) { /* row y's window costs */ });
+//   using namespace roiflow::flow;
+//   detail::StreamingZssd z(frame_t.cols, frame_t.rows, 7);
+//   std::vector<float> cost_row;
+//   const auto fill = [&](int y, float* d) {  // row y of the differences
+//     for (int x = 0; x < frame_t.cols; ++x)
+//       d[x] = float(frame_t1.at<uchar>(y, x)) - float(frame_t.at<uchar>(y, x));
+//   };
+//   const auto use = [&](int y, const float* cost) { std::cout << y << " " << cost[0] << "\n"; };
+//   detail::for_each_cost_row(z, fill, use, cost_row);
 //
 // A window's zero-mean SSD is sum d^2 - (sum d)^2 / n over its n pixels (clipped at the image
 // border) for the differences d = I1(x + f) - I0(x): a brightness offset between the frames

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <csignal>
 #include <filesystem>
 #include <iostream>
 
@@ -251,6 +252,20 @@ std::string compare_table(const CompareResult& r, const CompareOptions& o) {
                         speedup(l, g));
   }
   return text;
+}
+
+std::string compare_text(const CompareResult& r, const CompareOptions& options,
+                         const std::vector<std::string>& written) {
+  return compare_table(r, options) + "  wrote " + joined(written) +
+         "\n  per-mode logs and summaries: " +
+         (std::filesystem::path(options.out_dir) / "{local,global}.{csv,json}").string() + "\n";
+}
+
+Ending compare_ending(const CompareResult& r) {
+  if (!r.cancelled) return {};
+  const int sig = caught_signal();
+  return {128 + sig, std::string("interrupted by ") + (sig == SIGINT ? "SIGINT" : "SIGTERM") +
+                         " during the compare runs; no comparison written"};
 }
 
 }  // namespace roiflow::pipeline

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "pipeline/run.hpp"
+#include "pipeline/signals.hpp"
 
 namespace roiflow::pipeline {
 
@@ -54,5 +55,12 @@ double speedup(const CompareRun& local, const CompareRun& global);
 // Writes the comparison's files into options.out_dir; returns their paths.
 std::vector<std::string> write_compare_files(const CompareResult& r, const CompareOptions& options);
 std::string compare_table(const CompareResult& r, const CompareOptions& options);
+// What `roiflow track --compare` prints: the table, the files written, where each mode's log and
+// summary went.
+std::string compare_text(const CompareResult& r, const CompareOptions& options,
+                         const std::vector<std::string>& written);
+// After a cancelled comparison: 128 + the signal, "interrupted by SIGINT during the compare
+// runs; no comparison written"; else exit code 0.
+Ending compare_ending(const CompareResult& r);
 
 }  // namespace roiflow::pipeline

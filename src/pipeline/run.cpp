@@ -6,6 +6,7 @@
 #include <iostream>
 #include <optional>
 
+#include "core/atomic_write.hpp"
 #include "core/error.hpp"
 #include "core/text.hpp"
 #include "pipeline/dense_outputs.hpp"
@@ -145,6 +146,15 @@ TrackSummary run_track_video(stages::VideoSource& source, const TrackRunOptions&
   }
   s.status = source.status().message;
   return s;
+}
+
+void check_track_outputs(const std::string& log, const std::string& video,
+                         const std::string& summary, const std::string& mot) {
+  if (!log.empty()) stages::check_track_log_path(log, "--log");
+  for (const auto& [path, option] :
+       {std::pair{&mot, "--mot"}, {&video, "--out"}, {&summary, "--summary"}}) {
+    if (!path->empty()) check_output_path(*path, option);
+  }
 }
 
 DenseSummary run_dense_video(stages::VideoSource& source, const DenseRunOptions& options) {

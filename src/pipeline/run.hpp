@@ -91,6 +91,11 @@ TrackSummary run_track_stream(const FrameSource& frames, const StreamInfo& info,
 // Throws UsageError when less than `min_side` x `min_side` pixels of `init` (any part of it when
 // min_side is 0) lie inside a frame of `size`.
 void check_init_inside(const std::optional<cv::Rect2f>& init, cv::Size size, float min_side);
+// A track run's outputs, checked before any work: the track log `log` (--log), the annotated
+// `video` (--out), the `summary` (--summary) and a multi-object run's `mot` (--mot); empty ones
+// are not written. Throws roiflow::Error naming the option.
+void check_track_outputs(const std::string& log, const std::string& video,
+                         const std::string& summary, const std::string& mot = "");
 
 struct DenseRunOptions {
   flow::LkParams lk = flow::LkParams::paper();

@@ -2,6 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+
+#include "core/atomic_write.hpp"
+#include "core/text.hpp"
+
 namespace roiflow::pipeline {
 
 nlohmann::ordered_json to_json(const TrackSummary& s) {
@@ -35,6 +40,13 @@ nlohmann::ordered_json to_json(const DenseSummary& s, const std::string& preset)
           {"stages", report::stages_json(s.stages)}};
 }
 
+nlohmann::ordered_json summary_json(const TrackSummary& s, const Ending& end) {
+  nlohmann::ordered_json doc = to_json(s);
+  doc["input"] = s.input;
+  doc["status"] = end.message.empty() ? s.status : end.message;
+  return doc;
+}
+
 std::string summary_text(const std::string& what, const TrackSummary& s) {
   return fmt::format(
       "{}: {} frames in {:.2f} s, {:.1f} fps overall, tracker {:.1f} fps ({:.3f} ms/frame, decode "
@@ -46,6 +58,16 @@ std::string summary_text(const std::string& what, const TrackSummary& s) {
 std::string summary_text(const DenseSummary& s) {
   return fmt::format("dense {}: {} pairs in {:.2f} s, {:.1f} pairs/s, {} threads\n", s.input,
                      s.pairs, s.wall_s, s.fps, s.threads);
+}
+
+std::string finish_run(const std::string& summary, const nlohmann::ordered_json& doc,
+                       const std::string& text, std::vector<std::string> written) {
+  if (!summary.empty()) {
+    write_text_atomically(summary, doc.dump(2) + "\n");
+    written.push_back(summary);
+  }
+  written.erase(std::remove(written.begin(), written.end(), std::string()), written.end());
+  return text + (written.empty() ? "" : "  wrote " + joined(written) + "\n");
 }
 
 }  // namespace roiflow::pipeline

@@ -32,7 +32,10 @@ constexpr double kMinForegroundShare = 0.3;
 constexpr int kGrayBins = 32;
 constexpr int kColourBins = 8;   // per channel: 8^3 bins, coarse enough for lighting changes
 constexpr int kCoarseSide = 12;  // see by_appearance()
-constexpr int kHuUsed = 4;       // the higher Hu moments are dominated by contour noise
+constexpr std::size_t kColourLooks = 4;  // recent colour looks kept (remember_colour)
+constexpr int kHueBins = 12;             // colour looks: hue and saturation bins
+constexpr int kSatBins = 4;
+constexpr int kHuUsed = 4;  // the higher Hu moments are dominated by contour noise
 
 void check_image(const cv::Mat& image, const char* what) {
   if (image.empty() || image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3)) {
@@ -64,6 +67,23 @@ cv::Mat histogram(const cv::Mat& image, const cv::Mat& mask) {
     const float* ranges[] = {range, range, range};
     cv::calcHist(&image, 1, channels, mask, hist, 3, bins, ranges);
   }
+  const double total = cv::sum(hist)[0];
+  if (total > 0) hist /= total;
+  return hist;
+}
+
+// Hue and saturation (lighting changes move the value most), or the gray levels of a gray image;
+// normalised to sum 1.
+cv::Mat hue_histogram(const cv::Mat& image) {
+  if (image.channels() == 1) return histogram(image, cv::Mat());
+  cv::Mat hsv, hist;
+  cv::cvtColor(image, hsv, cv::COLOR_BGR2HSV);
+  const int channels[] = {0, 1};
+  const int bins[] = {kHueBins, kSatBins};
+  const float hue[] = {0.f, 180.f};
+  const float sat[] = {0.f, 256.f};
+  const float* ranges[] = {hue, sat};
+  cv::calcHist(&hsv, 1, channels, cv::Mat(), hist, 2, bins, ranges);
   const double total = cv::sum(hist)[0];
   if (total > 0) hist /= total;
   return hist;
@@ -143,6 +163,8 @@ struct GlobalDetector::Impl {
   cv::Mat templ;  // gray appearance captured by set_target
   cv::Size2f size;
   Signature signature;
+  cv::Mat hue;                        // the target's hue_histogram at set_target
+  std::vector<cv::Mat> colour_looks;  // recent colour histograms (remember_colour), oldest first
 
   // Model-resolution rectangle covering a full-resolution one.
   cv::Rect to_work(const cv::Rect& r) const {
@@ -375,6 +397,43 @@ void GlobalDetector::set_target(const cv::Mat& image, const cv::Rect2f& box) {
   }
   sig.hist = histogram(image(r), mask);
   s.signature = std::move(sig);
+  s.hue = hue_histogram(image(r));
+  s.colour_looks.clear();
+}
+
+namespace {
+
+// The pixels of `box` inside `image` (rounded), empty when fewer than 2x2.
+cv::Rect inside_pixels(const cv::Mat& image, const cv::Rect2f& box) {
+  const cv::Rect r =
+      cv::Rect(static_cast<int>(std::lround(box.x)), static_cast<int>(std::lround(box.y)),
+               static_cast<int>(std::lround(box.width)),
+               static_cast<int>(std::lround(box.height))) &
+      cv::Rect(0, 0, image.cols, image.rows);
+  return r.width < 2 || r.height < 2 ? cv::Rect() : r;
+}
+
+}  // namespace
+
+double GlobalDetector::colour_similarity(const cv::Mat& image, const cv::Rect2f& box) const {
+  const Impl& s = *impl_;
+  if (s.templ.empty() || image.empty() || image.channels() != s.signature.channels) return -1;
+  const cv::Rect r = inside_pixels(image, box);
+  if (r.empty()) return -1;
+  const cv::Mat h = hue_histogram(image(r));
+  double best = 1.0 - cv::compareHist(s.hue, h, cv::HISTCMP_BHATTACHARYYA);
+  for (const cv::Mat& look : s.colour_looks)
+    best = std::max(best, 1.0 - cv::compareHist(look, h, cv::HISTCMP_BHATTACHARYYA));
+  return best;
+}
+
+void GlobalDetector::remember_colour(const cv::Mat& image, const cv::Rect2f& box) {
+  Impl& s = *impl_;
+  if (s.templ.empty() || image.empty() || image.channels() != s.signature.channels) return;
+  const cv::Rect r = inside_pixels(image, box);
+  if (r.empty()) return;
+  if (s.colour_looks.size() >= kColourLooks) s.colour_looks.erase(s.colour_looks.begin());
+  s.colour_looks.push_back(hue_histogram(image(r)));
 }
 
 bool GlobalDetector::has_target() const {

@@ -59,6 +59,14 @@ class GlobalDetector {
   // Updates the expected size of the target (the tracker follows its scale) without changing
   // the appearance captured by set_target.
   void set_target_size(cv::Size2f size);
+  // How alike the colours of `box` in `image` (the kind of picture set_target() was given) and
+  // the target's are: 1 - the Bhattacharyya distance of their colour histograms, the best over
+  // the target's first look and the recent ones remember_colour() kept, in [0, 1]; -1 when the
+  // box leaves fewer than 2x2 pixels inside the image or no target is set.
+  double colour_similarity(const cv::Mat& image, const cv::Rect2f& box) const;
+  // Keeps the colours of `box` in `image` as a recent look of the target (the last few are
+  // kept besides the first; set_target() forgets them). Call it on confidently tracked frames.
+  void remember_colour(const cv::Mat& image, const cv::Rect2f& box);
 
   // Finds the target in the whole frame: by appearance (multi-scale NCC of the template) when
   // `by_appearance`, else among the moving objects by signature similarity (the nearest to

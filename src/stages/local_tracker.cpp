@@ -308,6 +308,16 @@ LocalResult LocalTracker::Impl::track(const LocalFrame& in) {
     // Found again only by a look as good as a confident frame's: a wide search meets lookalikes.
     const double needed = was_lost ? params.confident_appearance : params.trust_appearance;
     if (a.score < needed || a.at_edge) {
+      // Lost, but the flow holds: the box follows what the flow follows (the target, most often,
+      // turned to a side none of its looks shows), still reported lost until a look confirms it.
+      if (params.follow_lost && was_lost && flow_failure == LostReason::Found &&
+          cv::Rect2f(r.region).contains(c)) {
+        const cv::Point2f moved = c - centre(box);
+        lose(r, LostReason::Searching, box_at(c, box.size()), in);
+        velocity = moved;
+        r.velocity = velocity;
+        return r;
+      }
       return lose(r, was_lost ? LostReason::Searching : flow_failure, predicted_box, in);
     }
     c = a.centre;

@@ -80,6 +80,9 @@ struct LocalTrackerParams {
   int memory = 4;            // earlier looks kept besides the first (long-term memory), 0..16
   int memory_interval = 25;  // confident frames between two looks kept, >= 1
   double coast_decay = 0.9;  // velocity kept per frame while lost (coasting), [0, 1]
+  bool follow_lost = true;   // while lost, the box follows the flow where its checks pass (the
+                             // target seen from a side no look shows, most often) instead of
+                             // coasting; still reported lost until a look confirms it
   double max_reach = 8;      // while lost, the appearance search around the coasting box widens
                              // from 2 to this many times `search`, 2..100
   void validate() const;     // throws roiflow::Error naming the bad value

@@ -29,6 +29,10 @@ cv::Point2f centre(const cv::Rect2f& r) {
   return {r.x + 0.5f * r.width, r.y + 0.5f * r.height};
 }
 
+cv::Rect2f box_at(cv::Point2f c, cv::Size2f s) {
+  return {c.x - 0.5f * s.width, c.y - 0.5f * s.height, s.width, s.height};
+}
+
 // Median flow magnitude over a grid of the region's pixels that lie outside the object's box:
 // how fast the background moves, or -1 when the region holds too little of it to tell.
 double background_motion(const cv::Mat& flow, const cv::Rect& region, const cv::Rect2f& box) {
@@ -153,6 +157,13 @@ void TrackerParams::validate() const {
   if (redetect_interval < 1 || redetect_interval > 1000) {
     throw Error("tracker: redetect_interval must be in 1..1000, got " +
                 std::to_string(redetect_interval));
+  }
+  if (!(colour_verify >= -1 && colour_verify <= 1)) {
+    throw Error("tracker: colour_verify must be in [-1, 1], got " + number_text(colour_verify));
+  }
+  if (colour_interval < 1 || colour_interval > 1000) {
+    throw Error("tracker: colour_interval must be in 1..1000, got " +
+                std::to_string(colour_interval));
   }
   if (!(verify_far >= verify && verify_far <= 1)) {
     throw Error("tracker: verify_far must be in [verify, 1], got " + number_text(verify_far));
@@ -357,6 +368,11 @@ void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double
     // Only a confident frame tells the re-detection the target's size: a drifting box would
     // have it search at the drift's scale.
     if (r.appearance >= params.local.trust_appearance) detector.set_target_size(r.box.size());
+    // The colour memory follows the target (lighting, pose) from confident frames only.
+    if (params.colour_verify > -1 && r.appearance >= params.local.confident_appearance &&
+        frame.index % params.colour_interval == 0) {
+      detector.remember_colour(frame.picture(), r.box);
+    }
     return;
   }
   // Lost: the global treatment searches the whole frame; until it succeeds the box coasts.
@@ -391,14 +407,24 @@ void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double
         (1.5f + static_cast<float>(params.reach_growth) * static_cast<float>(frames_lost));
     accept = d.dot(d) <= reach * reach;
   }
+  // Gray NCC alone takes another object of the same shape: the colours must match one of the
+  // target's colour looks too.
+  if (accept && params.colour_verify > -1 &&
+      detector.colour_similarity(image, found->box) < params.colour_verify) {
+    accept = false;
+  }
+  // At the size the target was last held at: a whole-frame NCC search favours the smaller of
+  // its coarse scales (a part of the object matches as well as the whole), and re-detection
+  // after re-detection would shrink the box; the local treatment measures the size again.
+  const cv::Rect2f placed = accept ? box_at(centre(found->box), last_held.size()) : cv::Rect2f();
   // A re-detection is held to the same self-checks as a held box.
-  const LostReason again = accept ? self_check(frame, found->box) : LostReason::Found;
+  const LostReason again = accept ? self_check(frame, placed) : LostReason::Found;
   if (again != LostReason::Found) out.reason = again;
   if (accept && again == LostReason::Found) {
-    local.restart({frame.gray, frame.pyramid}, found->box);
+    local.restart({frame.gray, frame.pyramid}, placed);
     out.reason = LostReason::Found;
     lost = false;
-    out.box = found->box;
+    out.box = placed;
     return;
   }
   lost = true;

@@ -77,6 +77,12 @@ struct TrackerParams {
   double reach_growth = 0.05;
   // While the target stays lost, the whole-frame search runs every this many frames, 1..1000.
   int redetect_interval = 1;
+  // ... and its colours (hue and saturation) must match one of the target's colour looks
+  // (GlobalDetector::colour_similarity: the first, and recent ones kept every colour_interval
+  // frames while the target is held confidently) at least this much: gray NCC alone takes
+  // another car or person of the same shape; [-1, 1] (-1 = no colour check).
+  double colour_verify = 0.6;
+  int colour_interval = 32;  // 1..1000
   // A held box whose part inside the frame is narrower or lower than this is lost (a box that
   // collapsed, or hugs the border with the object outside the view), pixels, [0, 1000].
   double min_side = 8;

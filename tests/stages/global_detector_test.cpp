@@ -192,6 +192,31 @@ TEST(GlobalDetector, SignaturePicksTheTargetAmongTwoMovers) {
   }
 }
 
+// The colour check of a re-detection: the target's own box matches its colours, a decoy of other
+// colours does not, and a recoloured target (lighting, pose) matches once a look of it is kept.
+TEST(GlobalDetector, ColourSimilarityTellsTheTargetFromADecoyAndKeepsRecentLooks) {
+  const TrackingScene scene;
+  cv::Mat frame = scene.render(30);
+  const cv::Rect2f decoy = draw_decoy(frame, 30);
+  GlobalDetector detector;
+  EXPECT_EQ(detector.colour_similarity(frame, scene.box(30)), -1.0);  // no target yet
+  detector.set_target(frame, scene.box(30));
+  EXPECT_GT(detector.colour_similarity(frame, scene.box(30)), 0.95);
+  EXPECT_LT(detector.colour_similarity(frame, decoy), 0.3);
+  EXPECT_EQ(detector.colour_similarity(frame, cv::Rect2f(-50, -50, 20, 20)), -1.0);
+  // The same frame with blue and red swapped: the vehicle changes hue.
+  cv::Mat swapped;
+  cv::cvtColor(frame, swapped, cv::COLOR_BGR2RGB);
+  const double before = detector.colour_similarity(swapped, scene.box(30));
+  EXPECT_LT(before, 0.4);  // measured: 0.11 (the decoy 0.07)
+  detector.remember_colour(swapped, scene.box(30));
+  EXPECT_GT(detector.colour_similarity(swapped, scene.box(30)), 0.95);
+  EXPECT_GT(detector.colour_similarity(frame, scene.box(30)), 0.95);  // the first look stays
+  // set_target forgets the remembered looks.
+  detector.set_target(frame, scene.box(30));
+  EXPECT_NEAR(detector.colour_similarity(swapped, scene.box(30)), before, 1e-9);
+}
+
 TEST(GlobalDetector, NearBreaksTiesBetweenTwins) {
   // Two identical vehicles (the scene's and a copy moving the other way, higher up): the
   // one nearest to `near` wins.

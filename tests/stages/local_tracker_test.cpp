@@ -246,6 +246,7 @@ TEST(LocalTracker, BadParamsThrowNamingTheValue) {
       message([](auto& p) { p.lk_patches = -1; }).find("lk_patches must be in [0, 100], got -1"),
       std::string::npos);
   EXPECT_NE(message([](auto& p) { p.lk.patch = 99; }).find("99"), std::string::npos);
+  EXPECT_NE(message([](auto& p) { p.coast_decay = 2; }).find("coast_decay"), std::string::npos);
 }
 
 TEST(LocalTracker, BadBoxesAndFramesThrow) {

@@ -326,6 +326,10 @@ TEST(Tracker, BadParamsThrowNamingTheValue) {
   EXPECT_NE(message([](auto& p) { p.init = cv::Rect2f(1, 2, 0.5f, 10); }).find("0.5"),
             std::string::npos);
   EXPECT_NE(message([](auto& p) { p.camera_motion = -2; }).find("-2"), std::string::npos);
+  EXPECT_NE(message([](auto& p) { p.colour_verify = 1.5; }).find("colour_verify"),
+            std::string::npos);
+  EXPECT_NE(message([](auto& p) { p.colour_interval = 0; }).find("colour_interval"),
+            std::string::npos);
   EXPECT_NE(message([](auto& p) { p.held_learning = 1.5; }).find("held_learning"),
             std::string::npos);
   EXPECT_NE(message([](auto& p) { p.local.min_appearance = 3; }).find("got 3"), std::string::npos);
@@ -401,8 +405,10 @@ TEST(Tracker, DeferredColourIsMadeOnlyWhenNeededAndChangesNothing) {
     EXPECT_EQ(out.lost, e.lost) << "frame " << i;
     if (out.mode == TrackRecord::Mode::Global) ++global_frames;
   }
-  // The refreshes: every observe_interval-th frame while the target is held.
-  const long long refreshes = scene.frames() / params.observe_interval + 1;
+  // The refreshes: every observe_interval-th frame while the target is held; the colour looks,
+  // every colour_interval-th.
+  const long long refreshes =
+      scene.frames() / params.observe_interval + 1 + scene.frames() / params.colour_interval + 1;
   EXPECT_GT(made, 0);
   EXPECT_LE(made, global_frames + refreshes);
   EXPECT_LT(made, scene.frames() / 4);
