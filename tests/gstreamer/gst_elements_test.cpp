@@ -526,8 +526,10 @@ TEST_F(GstTest, DecodebinPipelineOnSharedVideo) {
                          " ! decodebin ! videoconvert ! roiflowtrack log=" + log + " ! fakesink"),
             "");
   EXPECT_GE(eval::read_track_csv(log).size(), 740u);  // 748-750 frames, as decoded
-  // a car is found and followed most of the time, as `roiflow track` does
-  EXPECT_GT(expect_log_equals_cli(video, log), 740u / 2);
+  // cars are found and followed, as `roiflow track` does (measured: 171 frames found; the
+  // tracker reports a receding car lost once its box collapses or holds no moving pixels, where
+  // it used to hold a 2x2 box at the border for hundreds of frames)
+  EXPECT_GT(expect_log_equals_cli(video, log), 740u / 8);
 }
 
 }  // namespace
