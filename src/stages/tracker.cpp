@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -122,6 +123,32 @@ cv::Rect2f refine_by_motion(const flow::Pyramid& previous, const flow::Pyramid& 
   return both.width >= 4.f && both.height >= 4.f ? both : moved;
 }
 
+// Where `box`'s pixels in `previous` went in `current`: the best normalised cross-correlation of
+// them within one box side (the longer) each way. The box moved there, or nothing when too
+// little of it lies inside the frame.
+std::optional<cv::Rect2f> follow_look(const cv::Mat& previous, const cv::Mat& current,
+                                      const cv::Rect2f& box) {
+  const cv::Rect frame(cv::Point(), current.size());
+  const cv::Rect patch =
+      cv::Rect(cv::Point(static_cast<int>(std::round(box.x)), static_cast<int>(std::round(box.y))),
+               cv::Size(static_cast<int>(std::round(box.width)),
+                        static_cast<int>(std::round(box.height)))) &
+      frame;
+  if (patch.width < 4 || patch.height < 4) return std::nullopt;
+  const int reach = std::max(patch.width, patch.height);
+  const cv::Rect window = cv::Rect(patch.x - reach, patch.y - reach, patch.width + 2 * reach,
+                                   patch.height + 2 * reach) &
+                          frame;
+  if (window.width < patch.width || window.height < patch.height) return std::nullopt;
+  cv::Mat score;
+  cv::matchTemplate(current(window), previous(patch), score, cv::TM_CCOEFF_NORMED);
+  cv::Point best;
+  cv::minMaxLoc(score, nullptr, nullptr, nullptr, &best);
+  const cv::Point2f shift(static_cast<float>(window.x + best.x - patch.x),
+                          static_cast<float>(window.y + best.y - patch.y));
+  return cv::Rect2f(box.tl() + shift, box.size());
+}
+
 }  // namespace
 
 void TrackerParams::validate() const {
@@ -164,6 +191,12 @@ void TrackerParams::validate() const {
     throw Error("tracker: colour_interval must be in 1..1000, got " +
                 std::to_string(colour_interval));
   }
+  if (confirm_frames < 1 || confirm_frames > 100) {
+    throw Error("tracker: confirm_frames must be in 1..100, got " + std::to_string(confirm_frames));
+  }
+  if (!(confirm_verify >= -1 && confirm_verify <= 1)) {
+    throw Error("tracker: confirm_verify must be in [-1, 1], got " + number_text(confirm_verify));
+  }
   if (!(verify_far >= verify && verify_far <= 1)) {
     throw Error("tracker: verify_far must be in [verify, 1], got " + number_text(verify_far));
   }
@@ -196,6 +229,11 @@ struct Tracker::Impl {
   long long frames_lost = 0;  // frames lost in a row
   long long activations = 0;
   long long observed_index = -1;  // the last frame given to the background model
+  // The provisional re-detection (confirm_frames): its box on the last lost frame and on how many
+  // consecutive lost frames it held (0 = none).
+  cv::Rect2f candidate;
+  int candidate_frames = 0;
+  long long candidate_seen = 0;  // the last frame it held on
 
   static LocalTrackerParams local_params(const TrackerParams& p) {
     p.validate();
@@ -314,6 +352,7 @@ void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double
   if (!r.lost) {
     lost = false;
     frames_lost = 0;
+    candidate_frames = 0;
     last_held = r.box;
     out.box = r.box;
     out.velocity = r.velocity;
@@ -337,6 +376,30 @@ void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double
   // The whole-frame search costs tens of local steps on a large frame: while the target stays
   // lost it runs on the first lost frame and then every redetect_interval frames (the local
   // treatment searches around the coasting box every frame).
+  // A provisional re-detection (confirm_frames) is followed by its own look and checked again.
+  if (candidate_frames > 0 && candidate_seen == frame.index - 1) {
+    const std::optional<cv::Rect2f> moved = follow_look(previous_gray, frame.gray, candidate);
+    const bool holds = moved &&
+                       local.verify({frame.gray, frame.pyramid}, *moved) >= params.confirm_verify &&
+                       (params.colour_verify <= -1 ||
+                        detector.colour_similarity(image, *moved) >= params.colour_verify);
+    candidate_frames = holds ? candidate_frames + 1 : 0;
+    if (holds) {
+      candidate = *moved;
+      candidate_seen = frame.index;
+    }
+    if (holds && candidate_frames >= params.confirm_frames) {
+      candidate_frames = 0;
+      const cv::Rect2f placed = box_at(centre(candidate), last_held.size());
+      local.restart({frame.gray, frame.pyramid}, placed);
+      out.reason = LostReason::Found;
+      lost = false;
+      out.box = placed;
+      return;
+    }
+  } else {
+    candidate_frames = 0;
+  }
   const bool search = (frames_lost % params.redetect_interval == 0);
   const std::optional<Detection> found =
       search ? detector.find_target(image, frame.gray, centre(r.box), by_appearance) : std::nullopt;
@@ -365,7 +428,20 @@ void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double
       detector.colour_similarity(image, found->box) < params.colour_verify) {
     accept = false;
   }
+  // Short of unmistakable, a re-detection is held provisionally: it is followed by its own look
+  // from frame to frame and taken once it has matched the target's looks and colours on
+  // confirm_frames consecutive frames (a lookalike the search returns for one frame does not
+  // capture the track).
+  if (accept && ver < params.verify_far && params.confirm_frames > 1) {
+    accept = false;
+    if (candidate_frames == 0) {
+      candidate = found->box;
+      candidate_frames = 1;
+      candidate_seen = frame.index;
+    }
+  }
   if (accept) {
+    candidate_frames = 0;
     // At the size the target was last held at: a whole-frame NCC search favours the smaller of
     // its coarse scales (a part of the object matches as well as the whole), and re-detection
     // after re-detection would shrink the box; the local treatment measures the size again.
@@ -380,6 +456,9 @@ void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double
   ++frames_lost;
   out.lost = true;
   out.box = r.box;
+  // The box goes where the provisional re-detection is; the target stays lost until it is
+  // confirmed.
+  if (candidate_frames > 0) out.box = box_at(centre(candidate), last_held.size());
   out.velocity = r.velocity;
 }
 
