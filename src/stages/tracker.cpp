@@ -275,6 +275,7 @@ struct Tracker::Impl {
   TrackerOutput process(const TrackerInput& frame);
   void acquire(const TrackerInput& frame, TrackerOutput& out);
   void follow(const TrackerInput& frame, TrackerOutput& out, double refresh_weight);
+  bool confirm_candidate(const TrackerInput& frame, const cv::Mat& image, TrackerOutput& out);
 
   // The background model is only needed to find a target that was not given. `weight`: the
   // frames of video this observation stands for. `beside`: as a job of the executor, beside the
@@ -334,6 +335,36 @@ void Tracker::Impl::acquire(const TrackerInput& frame, TrackerOutput& out) {
   out.has_target = true;
 }
 
+// A provisional re-detection (confirm_frames) is followed by its own look and checked again;
+// true when that confirms it (the target is placed there, `out` says so).
+bool Tracker::Impl::confirm_candidate(const TrackerInput& frame, const cv::Mat& image,
+                                      TrackerOutput& out) {
+  if (candidate_frames > 0 && candidate_seen == frame.index - 1) {
+    const std::optional<cv::Rect2f> moved = follow_look(previous_gray, frame.gray, candidate);
+    const bool holds = moved &&
+                       local.verify({frame.gray, frame.pyramid}, *moved) >= params.confirm_verify &&
+                       (params.colour_verify <= -1 ||
+                        detector.colour_similarity(image, *moved) >= params.colour_verify);
+    candidate_frames = holds ? candidate_frames + 1 : 0;
+    if (holds) {
+      candidate = *moved;
+      candidate_seen = frame.index;
+    }
+    if (holds && candidate_frames >= params.confirm_frames) {
+      candidate_frames = 0;
+      const cv::Rect2f placed = box_at(centre(candidate), last_held.size());
+      local.restart({frame.gray, frame.pyramid}, placed);
+      out.reason = LostReason::Found;
+      lost = false;
+      out.box = placed;
+      return true;
+    }
+  } else {
+    candidate_frames = 0;
+  }
+  return false;
+}
+
 void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double refresh_weight) {
   const cv::Rect2f before = local.box();  // where the object was on the grid of region_flow
   if (refresh_weight > 0) observe(frame, refresh_weight, true);
@@ -376,30 +407,7 @@ void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double
   // The whole-frame search costs tens of local steps on a large frame: while the target stays
   // lost it runs on the first lost frame and then every redetect_interval frames (the local
   // treatment searches around the coasting box every frame).
-  // A provisional re-detection (confirm_frames) is followed by its own look and checked again.
-  if (candidate_frames > 0 && candidate_seen == frame.index - 1) {
-    const std::optional<cv::Rect2f> moved = follow_look(previous_gray, frame.gray, candidate);
-    const bool holds = moved &&
-                       local.verify({frame.gray, frame.pyramid}, *moved) >= params.confirm_verify &&
-                       (params.colour_verify <= -1 ||
-                        detector.colour_similarity(image, *moved) >= params.colour_verify);
-    candidate_frames = holds ? candidate_frames + 1 : 0;
-    if (holds) {
-      candidate = *moved;
-      candidate_seen = frame.index;
-    }
-    if (holds && candidate_frames >= params.confirm_frames) {
-      candidate_frames = 0;
-      const cv::Rect2f placed = box_at(centre(candidate), last_held.size());
-      local.restart({frame.gray, frame.pyramid}, placed);
-      out.reason = LostReason::Found;
-      lost = false;
-      out.box = placed;
-      return;
-    }
-  } else {
-    candidate_frames = 0;
-  }
+  if (confirm_candidate(frame, image, out)) return;
   const bool search = (frames_lost % params.redetect_interval == 0);
   const std::optional<Detection> found =
       search ? detector.find_target(image, frame.gray, centre(r.box), by_appearance) : std::nullopt;
