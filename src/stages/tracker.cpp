@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <deque>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -123,6 +124,32 @@ cv::Rect2f refine_by_motion(const flow::Pyramid& previous, const flow::Pyramid& 
   return both.width >= 4.f && both.height >= 4.f ? both : moved;
 }
 
+// Where `box`'s pixels in `previous` went in `current`: the best normalised cross-correlation of
+// them within one box side (the longer) each way. The box moved there, or nothing when too
+// little of it lies inside the frame.
+std::optional<cv::Rect2f> follow_look(const cv::Mat& previous, const cv::Mat& current,
+                                      const cv::Rect2f& box) {
+  const cv::Rect frame(cv::Point(), current.size());
+  const cv::Rect patch =
+      cv::Rect(cv::Point(static_cast<int>(std::round(box.x)), static_cast<int>(std::round(box.y))),
+               cv::Size(static_cast<int>(std::round(box.width)),
+                        static_cast<int>(std::round(box.height)))) &
+      frame;
+  if (patch.width < 4 || patch.height < 4) return std::nullopt;
+  const int reach = std::max(patch.width, patch.height);
+  const cv::Rect window = cv::Rect(patch.x - reach, patch.y - reach, patch.width + 2 * reach,
+                                   patch.height + 2 * reach) &
+                          frame;
+  if (window.width < patch.width || window.height < patch.height) return std::nullopt;
+  cv::Mat score;
+  cv::matchTemplate(current(window), previous(patch), score, cv::TM_CCOEFF_NORMED);
+  cv::Point best;
+  cv::minMaxLoc(score, nullptr, nullptr, nullptr, &best);
+  const cv::Point2f shift(static_cast<float>(window.x + best.x - patch.x),
+                          static_cast<float>(window.y + best.y - patch.y));
+  return cv::Rect2f(box.tl() + shift, box.size());
+}
+
 }  // namespace
 
 void TrackerParams::validate() const {
@@ -164,6 +191,12 @@ void TrackerParams::validate() const {
   if (colour_interval < 1 || colour_interval > 1000) {
     throw Error("tracker: colour_interval must be in 1..1000, got " +
                 std::to_string(colour_interval));
+  }
+  if (confirm_frames < 1 || confirm_frames > 100) {
+    throw Error("tracker: confirm_frames must be in 1..100, got " + std::to_string(confirm_frames));
+  }
+  if (!(confirm_verify >= -1 && confirm_verify <= 1)) {
+    throw Error("tracker: confirm_verify must be in [-1, 1], got " + number_text(confirm_verify));
   }
   if (!(verify_far >= verify && verify_far <= 1)) {
     throw Error("tracker: verify_far must be in [verify, 1], got " + number_text(verify_far));
@@ -213,6 +246,11 @@ struct Tracker::Impl {
   float start_side = 0;       // the shorter side of the box the target was started from
   long long activations = 0;
   long long observed_index = -1;  // the last frame given to the background model
+  // The provisional re-detection (confirm_frames): its box on the last lost frame and on how many
+  // consecutive lost frames it held (0 = none).
+  cv::Rect2f candidate;
+  int candidate_frames = 0;
+  long long candidate_seen = 0;  // the last frame it held on
 
   static LocalTrackerParams local_params(const TrackerParams& p) {
     p.validate();
@@ -256,6 +294,7 @@ struct Tracker::Impl {
   void acquire(const TrackerInput& frame, TrackerOutput& out);
   void follow(const TrackerInput& frame, TrackerOutput& out, double refresh_weight);
   LostReason self_check(const TrackerInput& frame, const cv::Rect2f& box);
+  bool confirm_candidate(const TrackerInput& frame, const cv::Mat& image, TrackerOutput& out);
 
   // The background model is only needed to find a target that was not given. `weight`: the
   // frames of video this observation stands for. `beside`: as a job of the executor, beside the
@@ -342,6 +381,37 @@ LostReason Tracker::Impl::self_check(const TrackerInput& frame, const cv::Rect2f
   return still_run >= params.still_frames ? LostReason::Still : LostReason::Found;
 }
 
+// A provisional re-detection (confirm_frames) is followed by its own look and checked again;
+// true when that confirms it (the target is placed there, `out` says so).
+bool Tracker::Impl::confirm_candidate(const TrackerInput& frame, const cv::Mat& image,
+                                      TrackerOutput& out) {
+  if (candidate_frames > 0 && candidate_seen == frame.index - 1) {
+    const std::optional<cv::Rect2f> moved = follow_look(previous_gray, frame.gray, candidate);
+    const bool holds = moved &&
+                       local.verify({frame.gray, frame.pyramid}, *moved) >= params.confirm_verify &&
+                       (params.colour_verify <= -1 ||
+                        detector.colour_similarity(image, *moved) >= params.colour_verify);
+    candidate_frames = holds ? candidate_frames + 1 : 0;
+    if (holds) {
+      candidate = *moved;
+      candidate_seen = frame.index;
+    }
+    const cv::Rect2f placed = box_at(centre(candidate), last_held.size());
+    if (holds && candidate_frames >= params.confirm_frames &&
+        self_check(frame, placed) == LostReason::Found) {
+      candidate_frames = 0;
+      local.restart({frame.gray, frame.pyramid}, placed);
+      out.reason = LostReason::Found;
+      lost = false;
+      out.box = placed;
+      return true;
+    }
+  } else {
+    candidate_frames = 0;
+  }
+  return false;
+}
+
 void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double refresh_weight) {
   const cv::Rect2f before = local.box();  // where the object was on the grid of region_flow
   if (refresh_weight > 0) observe(frame, refresh_weight, true);
@@ -362,6 +432,7 @@ void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double
   if (self == LostReason::Found) {
     lost = false;
     frames_lost = 0;
+    candidate_frames = 0;
     last_held = r.box;
     out.box = r.box;
     out.velocity = r.velocity;
@@ -385,6 +456,7 @@ void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double
   // The whole-frame search costs tens of local steps on a large frame: while the target stays
   // lost it runs on the first lost frame and then every redetect_interval frames (the local
   // treatment searches around the coasting box every frame).
+  if (confirm_candidate(frame, image, out)) return;
   const bool search = (frames_lost % params.redetect_interval == 0);
   const std::optional<Detection> found =
       search ? detector.find_target(image, frame.gray, centre(r.box), by_appearance) : std::nullopt;
@@ -413,6 +485,18 @@ void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double
       detector.colour_similarity(image, found->box) < params.colour_verify) {
     accept = false;
   }
+  // Short of unmistakable, a re-detection is held provisionally: it is followed by its own look
+  // from frame to frame and taken once it has matched the target's looks and colours on
+  // confirm_frames consecutive frames (a lookalike the search returns for one frame does not
+  // capture the track).
+  if (accept && ver < params.verify_far && params.confirm_frames > 1) {
+    accept = false;
+    if (candidate_frames == 0) {
+      candidate = found->box;
+      candidate_frames = 1;
+      candidate_seen = frame.index;
+    }
+  }
   // At the size the target was last held at: a whole-frame NCC search favours the smaller of
   // its coarse scales (a part of the object matches as well as the whole), and re-detection
   // after re-detection would shrink the box; the local treatment measures the size again.
@@ -421,6 +505,7 @@ void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double
   const LostReason again = accept ? self_check(frame, placed) : LostReason::Found;
   if (again != LostReason::Found) out.reason = again;
   if (accept && again == LostReason::Found) {
+    candidate_frames = 0;
     local.restart({frame.gray, frame.pyramid}, placed);
     out.reason = LostReason::Found;
     lost = false;
@@ -431,6 +516,9 @@ void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double
   ++frames_lost;
   out.lost = true;
   out.box = r.box;
+  // The box goes where the provisional re-detection is; the target stays lost until it is
+  // confirmed.
+  if (candidate_frames > 0) out.box = box_at(centre(candidate), last_held.size());
   out.velocity = r.velocity;
 }
 

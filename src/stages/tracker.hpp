@@ -83,6 +83,15 @@ struct TrackerParams {
   // another car or person of the same shape; [-1, 1] (-1 = no colour check).
   double colour_verify = 0.6;
   int colour_interval = 32;  // 1..1000
+  // A re-detection short of verify_far is held provisionally and taken only once it has held on
+  // confirm_frames consecutive lost frames: followed from frame to frame by its own look
+  // (normalised cross-correlation within a box side), its NCC with the target's looks at least
+  // confirm_verify and its colours matching (colour_verify), so that a lookalike the search
+  // returns for one frame (another person during fast camera motion) does not capture the track.
+  // Meanwhile the target is reported lost, its box at the provisional one. 1 = take it at once;
+  // 1..100.
+  int confirm_frames = 2;
+  double confirm_verify = 0.5;  // [-1, 1]
   // A held box whose part inside the frame is narrower or lower than this is lost (a box that
   // collapsed, or hugs the border with the object outside the view), pixels, [0, 1000].
   double min_side = 8;

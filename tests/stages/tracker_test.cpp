@@ -332,6 +332,10 @@ TEST(Tracker, BadParamsThrowNamingTheValue) {
             std::string::npos);
   EXPECT_NE(message([](auto& p) { p.held_learning = 1.5; }).find("held_learning"),
             std::string::npos);
+  EXPECT_NE(message([](auto& p) { p.confirm_frames = 0; }).find("confirm_frames"),
+            std::string::npos);
+  EXPECT_NE(message([](auto& p) { p.confirm_verify = -2; }).find("confirm_verify"),
+            std::string::npos);
   EXPECT_NE(message([](auto& p) { p.local.min_appearance = 3; }).find("got 3"), std::string::npos);
   EXPECT_NE(message([](auto& p) { p.detector.history = 1; }).find("got 1"), std::string::npos);
 }
@@ -445,6 +449,66 @@ TEST(Tracker, AWrongPyramidOrColourGrayThrows) {
   in = input(tracker, scene.render(0), 0);
   in.gray = scene.render(0);
   EXPECT_NE(error_message([&] { tracker.process(in); }).find("8UC3"), std::string::npos);
+}
+
+// A static textured background with a textured target moving 1 px a frame; on `decoy_frame`
+// the target is hidden and a noisy copy of it (a lookalike) appears 50 px to its right, for that
+// frame only.
+struct DecoyScene {
+  cv::Mat background, look;
+  int decoy_frame = 10;
+  DecoyScene() {
+    cv::RNG rng(7);
+    background.create(240, 320, CV_8UC3);
+    rng.fill(background, cv::RNG::UNIFORM, 0, 255);
+    cv::GaussianBlur(background, background, {0, 0}, 3.0);
+    look.create(40, 40, CV_8UC3);
+    rng.fill(look, cv::RNG::UNIFORM, 0, 255);
+    cv::GaussianBlur(look, look, {0, 0}, 1.5);
+    look += cv::Scalar(60, 0, 0);
+  }
+  cv::Rect2f box(int i) const { return {100.f + static_cast<float>(i), 100.f, 40.f, 40.f}; }
+  cv::Mat render(int i) const {
+    cv::Mat out = background.clone();
+    if (i != decoy_frame) {
+      look.copyTo(out(cv::Rect(box(i))));
+    } else {
+      cv::Mat noisy(look.size(), CV_16SC3);
+      cv::RNG rng(11);
+      rng.fill(noisy, cv::RNG::NORMAL, 0, 12);
+      cv::Mat decoy;
+      cv::add(look, noisy, decoy, cv::noArray(), CV_8UC3);
+      decoy.copyTo(out(cv::Rect(box(i) + cv::Point2f(50.f, 0.f))));
+    }
+    return out;
+  }
+};
+
+TEST(Tracker, ALookalikeSeenForOneFrameDoesNotCaptureTheTrack) {
+  const DecoyScene scene;
+  const auto outputs = [&](int confirm_frames) {
+    TrackerParams p;
+    p.init = scene.box(0);
+    p.verify_far = 1.0;  // no re-detection is unmistakable: each one is held provisionally
+    p.confirm_frames = confirm_frames;
+    Tracker tracker(p);
+    std::vector<TrackerOutput> outs;
+    for (int i = 0; i < 20; ++i)
+      outs.push_back(tracker.process(input(tracker, scene.render(i), i)));
+    return outs;
+  };
+  const std::vector<TrackerOutput> held = outputs(2);
+  const int d = scene.decoy_frame;
+  // The lookalike is not reported found; the real target is followed again once it is back.
+  EXPECT_TRUE(held[d].lost);
+  for (int i = d + 1; i < 20; ++i) {
+    EXPECT_FALSE(held[i].lost) << "frame " << i;
+    EXPECT_GT(iou(held[i].box, scene.box(i)), 0.7) << "frame " << i;
+  }
+  // Taken at once, the lookalike is reported as the target (the baseline this guards against).
+  const std::vector<TrackerOutput> at_once = outputs(1);
+  EXPECT_FALSE(at_once[d].lost);
+  EXPECT_GT(iou(at_once[d].box, scene.box(d) + cv::Point2f(50.f, 0.f)), 0.7);
 }
 
 }  // namespace
