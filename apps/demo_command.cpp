@@ -3,41 +3,10 @@
 #include <iostream>
 
 #include "cli_common.hpp"
-#include "pipeline/demo.hpp"
 #include "pipeline/mot_demo.hpp"
 #include "pipeline/tbb_executor.hpp"
 
 namespace roiflow::cli {
-namespace {
-
-int objects_demo(const pipeline::DemoOptions& d, int objects, bool frames_given) {
-  pipeline::MotDemoOptions o;
-  o.dir = d.dir, o.objects = objects, o.frames = frames_given ? d.frames : 300;
-  o.threads = d.threads, o.progress = d.progress, o.cancel = d.cancel;
-  const pipeline::MotDemoResult r = pipeline::run_mot_demo(o);
-  if (r.cancelled) {
-    std::cerr << "roiflow: error: interrupted\n";
-    return 128 + pipeline::caught_signal();
-  }
-  std::cout << pipeline::mot_demo_text(r, o.threads);
-  return 0;
-}
-
-int demo(pipeline::DemoOptions options, int objects, bool frames_given) {
-  if (options.threads == 0) options.threads = pipeline::default_threads();
-  options.cancel = pipeline::cancel_flag();
-  pipeline::SignalScope signals;
-  if (objects > 0) return objects_demo(options, objects, frames_given);
-  const pipeline::DemoResult r = pipeline::run_demo(options);
-  if (r.local.end == pipeline::RunEnd::Cancelled) {
-    std::cerr << "roiflow: error: interrupted\n";
-    return 128 + pipeline::caught_signal();
-  }
-  std::cout << pipeline::demo_text(r);
-  return 0;
-}
-
-}  // namespace
 
 void add_demo_command(CLI::App& app, int& exit_code) {
   static pipeline::DemoOptions cmd;  // threads 0: all
@@ -59,7 +28,17 @@ void add_demo_command(CLI::App& app, int& exit_code) {
   sub->add_option("--threads", cmd.threads, "worker threads (0 = all)")
       ->check(CLI::Range(0, pipeline::kMaxThreads));
   sub->add_flag("!--no-progress", cmd.progress, "no progress bar on the terminal");
-  sub->callback([&exit_code, frames] { exit_code = demo(cmd, objects, frames->count() > 0); });
+  sub->callback([&exit_code, frames] {
+    pipeline::DemoOptions o = cmd;
+    if (o.threads == 0) o.threads = pipeline::default_threads();
+    o.cancel = pipeline::cancel_flag();
+    pipeline::SignalScope signals;
+    const std::optional<std::string> text =
+        pipeline::demo_command_text(o, objects, frames->count() > 0);
+    if (text) std::cout << *text;
+    exit_code = run_end(text ? pipeline::Ending{}
+                             : pipeline::Ending{128 + pipeline::caught_signal(), "interrupted"});
+  });
 }
 
 }  // namespace roiflow::cli

@@ -1,25 +1,17 @@
-// roiflow motion-check VIDEO LOG: objects a track log reports found while their box holds no
-// moving pixels or has collapsed (pipeline::check_motion). Exit 0 when no run exceeds
-// --max-run frames, 1 otherwise (or on bad input).
-//
-//   roiflow motion-check ../shared/data/video/opencv_vtest.avi out/track.csv --format json
-#include <CLI/CLI.hpp>
+// roiflow motion-check VIDEO LOG: found boxes without moving pixels or collapsed (exit 1 when a run
+// exceeds --max-run frames; pipeline/motion_check.hpp).
 #include <iostream>
-#include <string>
 
 #include "cli_common.hpp"
-#include "eval/track_log.hpp"
 #include "pipeline/motion_check.hpp"
-#include "stages/video_source.hpp"
 
 namespace roiflow::cli {
 
 void add_motion_check_command(CLI::App& app, int& exit_code) {
-  struct Cmd {
+  static struct {
     std::string video, log, format = "table";
     pipeline::MotionCheckParams params;
-  };
-  static Cmd cmd;
+  } cmd;
   CLI::App* sub = app.add_subcommand(
       "motion-check",
       "Check a track log against the video's moving pixels: no object reported found on empty "

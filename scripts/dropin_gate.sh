@@ -34,7 +34,9 @@ gate_count "roiflow track log rows" "$cli_rows" 795
 gate_count "roiflowtrack log rows" "$gst_rows" "$cli_rows"
 differ=$(diff <(cut -d, -f1-9 "$work/cli.csv") <(cut -d, -f1-9 "$work/gst.csv") | grep -c '^>' || true)
 gate_count "rows where roiflowtrack differs from roiflow track" "$differ" 0
-awk -F, 'NR > 1 { print $2 "," $3 "," $4 "," $5 }' "$work/cli.csv" >"$work/cli_boxes.txt"
+# The box columns x,y,w,h, found by name (the log gained an id column after frame).
+awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) col[$i] = i; next }
+  { print $col["x"] "," $col["y"] "," $col["w"] "," $col["h"] }' "$work/cli.csv" >"$work/cli_boxes.txt"
 json=$("$bin" score "$work/gst.csv" "$work/cli_boxes.txt" --format json) ||
   gate_fail "roiflow score cannot read the element's log"
 iou=$(gate_json_number "$json" mean_iou)

@@ -110,4 +110,23 @@ std::string mot_demo_text(const MotDemoResult& r, int threads) {
       s.fn, s.gt_boxes, s.objects, r.mot, r.ground_truth, r.log, r.video, r.summary_path);
 }
 
+std::optional<std::string> demo_command_text(const DemoOptions& options, int objects,
+                                             bool frames_given) {
+  if (objects == 0) {
+    const DemoResult r = run_demo(options);
+    if (r.local.end == RunEnd::Cancelled) return std::nullopt;
+    return demo_text(r);
+  }
+  MotDemoOptions o;
+  o.dir = options.dir;
+  o.objects = objects;
+  o.frames = frames_given ? options.frames : 300;
+  o.threads = options.threads;
+  o.progress = options.progress;
+  o.cancel = options.cancel;
+  const MotDemoResult r = run_mot_demo(o);
+  if (r.cancelled) return std::nullopt;
+  return mot_demo_text(r, o.threads);
+}
+
 }  // namespace roiflow::pipeline

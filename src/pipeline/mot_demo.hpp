@@ -19,9 +19,11 @@
 #include <atomic>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 
 #include "eval/mot.hpp"
+#include "pipeline/demo.hpp"
 
 namespace roiflow::pipeline {
 
@@ -47,5 +49,11 @@ struct MotDemoResult {
 MotDemoResult run_mot_demo(const MotDemoOptions& options);
 // What `roiflow demo --objects N` prints: the run, the score and the files, lines ending in '\n'.
 std::string mot_demo_text(const MotDemoResult& r, int threads);
+
+// `roiflow demo`: run_demo, or with `objects` > 0 run_mot_demo on that many vehicles (the
+// options' frames when `frames_given`, else 300), with the options' threads, progress and
+// cancel flag. Returns what the command prints; nothing when the cancel flag cut the run short.
+std::optional<std::string> demo_command_text(const DemoOptions& options, int objects,
+                                             bool frames_given);
 
 }  // namespace roiflow::pipeline
