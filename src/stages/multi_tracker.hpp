@@ -149,7 +149,7 @@ struct MotObject {
 // One decided frame, as the sinks see it.
 struct MotFrame {
   long long index = 0;
-  std::vector<MotObject> objects;                     // confirmed objects, lost ones flagged
+  std::vector<MotObject> objects;                         // confirmed objects, lost ones flagged
   bool global = false;                                    // births were searched on this frame
   long long born = 0, ended = 0, global_activations = 0;  // running totals
   double ms = 0;                                          // tracker time of this frame

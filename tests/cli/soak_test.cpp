@@ -26,8 +26,8 @@ TEST_F(SoakTest, TrackOverASyntheticStreamKeepsEveryFrameInOrder) {
   constexpr long long kFrames = 1500;
   const std::string command =
       std::string("'") + ROIFLOW_CLI_PATH + "' track synthetic:" + std::to_string(kFrames) +
-      ":160x120 --single --threads 2 --no-progress" + " --log '" + path("log.csv") + "' --summary '" +
-      path("summary.json") + "' >'" + path("out.txt") + "' 2>&1";
+      ":160x120 --single --threads 2 --no-progress" + " --log '" + path("log.csv") +
+      "' --summary '" + path("summary.json") + "' >'" + path("out.txt") + "' 2>&1";
   const int status = std::system(command.c_str());
   std::ifstream out_file(path("out.txt"));
   const std::string out{std::istreambuf_iterator<char>(out_file), {}};
