@@ -248,27 +248,20 @@ void flow_from_pyramids(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkPar
   const cv::Mat u = view(ws.u[0], comp[0].size())(crop), v = view(ws.v[0], comp[0].size())(crop);
   const cv::Mat confidence = view(ws.confidence, comp[plan.finest].size());
   result.flow.create(crop.size(), CV_32FC2);
-  if (plan.finest > 0) {
-    result.confidence.create(crop.size(), CV_32F);
-    exec.for_range(0, crop.height, 64, [&](int y0, int y1) {
-      const cv::Rect rows(0, y0, crop.width, y1 - y0);
-      const cv::Mat planes[] = {u(rows), v(rows)};
-      cv::Mat out = result.flow(rows);
-      cv::merge(planes, 2, out);
+  result.confidence.create(crop.size(), CV_32F);
+  // Row blocks on the executor: at VGA these copies are a few per cent of a pair.
+  exec.for_range(0, crop.height, 64, [&](int y0, int y1) {
+    const cv::Rect rows(0, y0, crop.width, y1 - y0);
+    const cv::Mat planes[] = {u(rows), v(rows)};
+    cv::Mat out = result.flow(rows);
+    cv::merge(planes, 2, out);
+    if (plan.finest > 0) {
       confidence_to_level0(confidence, comp[plan.finest], plan.finest, region, result.confidence,
                            y0, y1);
-    });
-  } else {
-    result.confidence.create(crop.size(), CV_32F);
-    // Row blocks on the executor: at VGA these copies are a few per cent of a pair.
-    exec.for_range(0, crop.height, 64, [&](int y0, int y1) {
-      const cv::Rect rows(0, y0, crop.width, y1 - y0);
-      const cv::Mat planes[] = {u(rows), v(rows)};
-      cv::Mat out = result.flow(rows);
-      cv::merge(planes, 2, out);
+    } else {
       confidence(crop)(rows).copyTo(result.confidence(rows));
-    });
-  }
+    }
+  });
   result.region = region;
 }
 

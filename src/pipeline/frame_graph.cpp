@@ -138,33 +138,6 @@ class PyramidPool : public std::enable_shared_from_this<PyramidPool> {
   std::vector<std::unique_ptr<flow::Pyramid>> free_;
 };
 
-// DenseLK objects for the flow nodes of one run: a pair borrows one (its workspace stays warm:
-// allocating ~10 MB per pair costs page faults) and gives it back. A free list, not one per
-// thread: a thread that waits inside OpenCV's TBB loops may start another pair meanwhile.
-class DenseLkPool {
- public:
-  explicit DenseLkPool(const flow::LkParams& params) : params_(params) {}
-  void calc(const flow::Pyramid& t, const flow::Pyramid& t1, flow::FlowResult& result) {
-    std::unique_ptr<flow::DenseLK> lk;
-    {
-      const std::lock_guard<std::mutex> lock(mutex_);
-      if (!free_.empty()) {
-        lk = std::move(free_.back());
-        free_.pop_back();
-      }
-    }
-    if (!lk) lk = std::make_unique<flow::DenseLK>(params_);
-    lk->calc(t, t1, result);
-    const std::lock_guard<std::mutex> lock(mutex_);
-    free_.push_back(std::move(lk));
-  }
-
- private:
-  flow::LkParams params_;
-  std::mutex mutex_;
-  std::vector<std::unique_ptr<flow::DenseLK>> free_;
-};
-
 // source -> limiter -> level 0 -> level 1 -> ... -> sequencer: the part both modes share.
 class FrontEnd {
  public:
@@ -409,7 +382,7 @@ RunReport run_dense(const FrameSource& source, const flow::LkParams& params,
       previous = m;
     });
 
-    DenseLkPool lk_pool(params);
+    LkPool lk_pool(params);
     tf::function_node<PairJob, FlowPair> flow_node(g, tf::unlimited, [&](const PairJob& job) {
       run.enter(Stage::Flow, job.seq);
       const auto t0 = Clock::now();
@@ -417,7 +390,9 @@ RunReport run_dense(const FrameSource& source, const flow::LkParams& params,
       // One thread per pair: the limiter keeps more pairs in flight than there are threads,
       // and splitting each pair in row tiles as well cost ~15 % of the throughput (measured
       // with pipeline_bench BM_Dense at 2 threads: 171 -> 200 pairs/s without tiles).
-      lk_pool.calc(*job.t.pyramid, *job.t1.pyramid, *result);
+      std::unique_ptr<flow::DenseLK> lk = lk_pool.take();
+      lk->calc(*job.t.pyramid, *job.t1.pyramid, *result);
+      lk_pool.give_back(std::move(lk));
       run.time("flow", t0);
       return FlowPair{job.seq, job.t.frame, job.t1.frame, std::move(result)};
     });

@@ -84,7 +84,10 @@ class TileCollector {
   std::unordered_map<const FrameWork*, std::vector<stages::TileMotion>> pending_;
 };
 
-// The DenseLK workspaces of the LK tile tasks: each task borrows one (it stays warm).
+// DenseLK objects of one run, for the dense flow nodes and the LK tile tasks: a task borrows one
+// (its workspace stays warm: allocating ~10 MB per pair costs page faults) and gives it back. A
+// free list, not one per thread: a thread that waits inside OpenCV's TBB loops may start
+// another task meanwhile.
 class LkPool {
  public:
   explicit LkPool(const flow::LkParams& params) : params_(params) {}
