@@ -75,6 +75,7 @@ void LocalTrackerParams::validate() const {
   check_range("memory_interval", memory_interval, 1, 1e9);
   check_range("coast_decay", coast_decay, 0, 1);
   check_range("max_reach", max_reach, 2, 100);
+  check_range("lost_prior", lost_prior, 0, 1);
 }
 
 const char* to_string(LostReason reason) {
@@ -387,6 +388,14 @@ void LocalTracker::start(const LocalFrame& frame, const cv::Rect2f& box) {
 void LocalTracker::restart(const LocalFrame& frame, const cv::Rect2f& box) {
   if (impl_->templ.empty()) throw Error("local tracker: restart() before start()");
   impl_->place(frame, box);
+}
+
+void LocalTracker::restart(const LocalFrame& frame, const cv::Rect2f& box, cv::Point2f velocity) {
+  if (!(std::isfinite(velocity.x) && std::isfinite(velocity.y))) {
+    throw Error("local tracker: restart() velocity must be finite");
+  }
+  restart(frame, box);
+  impl_->velocity = velocity;
 }
 
 double LocalTracker::verify(const LocalFrame& frame, const cv::Rect2f& box) {

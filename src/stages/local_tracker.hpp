@@ -53,8 +53,8 @@ struct LocalTrackerParams {
   double appearance_weight = 0.5;  // how far the box moves to the appearance match, [0, 1]
   double search = 0.15;            // appearance search radius, as a share of the box's shorter
                                    // side (at least 3 pixels of the match level), (0, 2]
-  double scale_step = 0.03;        // relative step between the matched scales, (0, 0.5)
-  int scale_steps = 1;             // scales matched on each side of the measured one, 0..10
+  double scale_step = 0.0125;      // relative step between the matched scales, (0, 0.5)
+  int scale_steps = 5;             // scales matched on each side of the measured one, 0..10
   int match_side = 20;             // the shorter side the template is matched at (the finest
                                    // pyramid level where the object is at least this size), 8..256
   int template_interval = 10;      // frames between refreshes of the recent appearance (taken
@@ -83,6 +83,8 @@ struct LocalTrackerParams {
   bool follow_lost = true;   // while lost, the box follows the flow where its checks pass (the
                              // target seen from a side no look shows, most often) instead of
                              // coasting; still reported lost until a look confirms it
+  double lost_prior = 0.05;  // while lost, a match at the search's edge ranks this much NCC below
+                             // an equal one at the prediction (template_search's prior), [0, 1]
   double max_reach = 8;      // while lost, the appearance search around the coasting box widens
                              // from 2 to this many times `search`, 2..100
   void validate() const;     // throws roiflow::Error naming the bad value
@@ -149,6 +151,8 @@ class LocalTracker {
   void start(const LocalFrame& frame, const cv::Rect2f& box);
   // Places the object again (after a re-detection) keeping the appearance captured by start().
   void restart(const LocalFrame& frame, const cv::Rect2f& box);
+  // ... with a known velocity (pixels per frame): the next track() predicts the box there.
+  void restart(const LocalFrame& frame, const cv::Rect2f& box, cv::Point2f velocity);
   bool started() const;
   // Best NCC of the target's looks (first, recent, remembered) around `box` in `frame`, at a few
   // scales: how well a re-detection there matches; -1 when nothing could be matched. Does not

@@ -44,6 +44,10 @@ Appearance LocalTracker::Impl::match(const cv::Mat& appearance, ScaledTemplates&
   TemplateSearchParams tp;
   tp.coarse_side = 0;
   tp.scales = {1.0};  // the template comes resized
+  // A wide search (the target lost) meets lookalikes: of nearly equal matches, the one nearer the
+  // prediction wins.
+  MatchPrior prior;
+  if (reach > 1.0) prior = {ck, radius, params.lost_prior};
   for (int k = 0; k < n; ++k) {
     const int j = k == 0 ? middle : (k <= middle ? k - 1 : k);
     const double ratio = std::pow(1.0 + params.scale_step, j - params.scale_steps);
@@ -56,8 +60,8 @@ Appearance LocalTracker::Impl::match(const cv::Mat& appearance, ScaledTemplates&
     const cv::Rect window =
         enclosing(cv::Rect2f(static_cast<float>(at.x - half_w), static_cast<float>(at.y - half_h),
                              static_cast<float>(2 * half_w), static_cast<float>(2 * half_h)));
-    found[j] =
-        match_template(image, sizes.at(appearance, scaled_size(appearance, scale)), window, tp);
+    found[j] = match_template(image, sizes.at(appearance, scaled_size(appearance, scale)), window,
+                              tp, prior);
     if (j == middle) middle_window = window & cv::Rect(cv::Point(), image.size());
     // The size really matched: match_template rounds the scaled template to whole pixels.
     log_scale[j] = found[j].score > -1 ? 0.5 * std::log(static_cast<double>(found[j].box.area()) /

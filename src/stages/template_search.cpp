@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #ifdef __AVX2__
 #include <immintrin.h>
 #endif
@@ -200,8 +201,13 @@ cv::Mat resize_template(const cv::Mat& src, cv::Size size) {
 
 namespace {
 
+bool prior_on(const MatchPrior& p) {
+  return p.radius > 0 && p.penalty > 0;
+}
+
 // Best full-resolution match of `templ` (already scaled) in `region` of `image`.
-TemplateMatch match_one(const cv::Mat& image, const cv::Mat& templ, const cv::Rect& region) {
+TemplateMatch match_one(const cv::Mat& image, const cv::Mat& templ, const cv::Rect& region,
+                        const MatchPrior& prior = {}) {
   TemplateMatch best;
   if (region.width < templ.cols || region.height < templ.rows) return best;
   thread_local cv::Mat response;  // reused: see DirectScratch
@@ -213,8 +219,33 @@ TemplateMatch match_one(const cv::Mat& image, const cv::Mat& templ, const cv::Re
     cv::matchTemplate(image(region), templ, response, cv::TM_CCOEFF_NORMED);
   }
   double max_value = 0;
+  double ranked = 0;
   cv::Point at;
-  cv::minMaxLoc(response, nullptr, &max_value, nullptr, &at);
+  if (prior_on(prior)) {
+    // The centre of the match at response pixel (x, y), relative to the prior's.
+    const float cx =
+        static_cast<float>(region.x) + 0.5f * static_cast<float>(templ.cols) - prior.centre.x;
+    const float cy =
+        static_cast<float>(region.y) + 0.5f * static_cast<float>(templ.rows) - prior.centre.y;
+    const auto k = static_cast<float>(prior.penalty / (prior.radius * prior.radius));
+    ranked = -std::numeric_limits<double>::infinity();
+    for (int y = 0; y < response.rows; ++y) {
+      const float* row = response.ptr<float>(y);
+      const float dy = cy + static_cast<float>(y);
+      for (int x = 0; x < response.cols; ++x) {
+        const float dx = cx + static_cast<float>(x);
+        const float r = row[x] - k * (dx * dx + dy * dy);
+        if (r > ranked) {
+          ranked = r;
+          at = {x, y};
+        }
+      }
+    }
+    max_value = response.at<float>(at);
+  } else {
+    cv::minMaxLoc(response, nullptr, &max_value, nullptr, &at);
+    ranked = max_value;
+  }
   if (!std::isfinite(max_value)) return best;
   float dx = 0.f, dy = 0.f;
   if (at.x > 0 && at.x + 1 < response.cols) {
@@ -226,6 +257,7 @@ TemplateMatch match_one(const cv::Mat& image, const cv::Mat& templ, const cv::Re
                        response.at<float>(at.y + 1, at.x));
   }
   best.score = max_value;
+  best.ranked = ranked;
   best.box =
       cv::Rect2f(static_cast<float>(region.x + at.x) + dx, static_cast<float>(region.y + at.y) + dy,
                  static_cast<float>(templ.cols), static_cast<float>(templ.rows));
@@ -235,7 +267,7 @@ TemplateMatch match_one(const cv::Mat& image, const cv::Mat& templ, const cv::Re
 }  // namespace
 
 TemplateMatch match_template(const cv::Mat& image, const cv::Mat& templ, const cv::Rect& search,
-                             const TemplateSearchParams& params) {
+                             const TemplateSearchParams& params, const MatchPrior& prior) {
   if (image.empty() || templ.empty()) throw Error("template search: empty image or template");
   if (image.channels() != 1 || templ.channels() != 1) {
     throw Error("template search: image and template must be single-channel");
@@ -245,6 +277,9 @@ TemplateMatch match_template(const cv::Mat& image, const cv::Mat& templ, const c
                 cv::typeToString(image.type()) + " and " + cv::typeToString(templ.type()));
   }
   if (params.scales.empty()) throw Error("template search: no scales given");
+  if (!(prior.radius >= 0 && prior.penalty >= 0)) {
+    throw Error("template search: the prior's radius and penalty must be >= 0");
+  }
   for (double s : params.scales) {
     if (!(s > 0.0) || !std::isfinite(s)) {
       throw Error("template search: scales must be positive, got " + std::to_string(s));
@@ -271,18 +306,21 @@ TemplateMatch match_template(const cv::Mat& image, const cv::Mat& templ, const c
         continue;
       }
       const cv::Mat small_image = resize_template(image(region), coarse_region);
+      const MatchPrior small_prior{
+          (prior.centre - cv::Point2f(region.tl())) * static_cast<float>(f), prior.radius * f,
+          prior.penalty};
       const TemplateMatch coarse = match_one(small_image, resize_template(scaled, coarse_templ),
-                                             cv::Rect(cv::Point(), coarse_region));
+                                             cv::Rect(cv::Point(), coarse_region), small_prior);
       if (coarse.score <= -1) continue;
       const int pad = static_cast<int>(std::ceil(2.0 / f)) + 1;
       const cv::Rect window(region.x + static_cast<int>(std::lround(coarse.box.x / f)) - pad,
                             region.y + static_cast<int>(std::lround(coarse.box.y / f)) - pad,
                             size.width + 2 * pad, size.height + 2 * pad);
-      m = match_one(image, scaled, window & region);
+      m = match_one(image, scaled, window & region, prior);
     } else {
-      m = match_one(image, scaled, region);
+      m = match_one(image, scaled, region, prior);
     }
-    if (m.score > best.score) {
+    if (m.score > -1 && (best.score <= -1 || m.ranked > best.ranked)) {
       best = m;
       best.scale = scale;
     }

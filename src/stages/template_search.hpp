@@ -14,9 +14,10 @@
 namespace roiflow::stages {
 
 struct TemplateMatch {
-  cv::Rect2f box;     // in image coordinates
-  double score = -1;  // NCC of the best match, -1 when nothing was searched
-  double scale = 1;   // the scale (of those given) that won
+  cv::Rect2f box;      // in image coordinates
+  double score = -1;   // NCC of the best match, -1 when nothing was searched
+  double scale = 1;    // the scale (of those given) that won
+  double ranked = -1;  // what chose it: `score` less the prior's penalty (= score without one)
 };
 
 struct TemplateSearchParams {
@@ -24,10 +25,19 @@ struct TemplateSearchParams {
   int coarse_side = 24;             // coarse-to-fine above this template side; 0 = never
 };
 
+// A prior on where the match's centre is (image coordinates; none while radius or penalty is 0):
+// a position d pixels from `centre` ranks as its NCC less penalty x (d / radius)^2, so of two
+// nearly equal matches the nearer wins (an object does not jump to a lookalike).
+struct MatchPrior {
+  cv::Point2f centre;
+  double radius = 0;   // >= 0
+  double penalty = 0;  // >= 0
+};
+
 // `image` and `templ`: 8-bit or float single channel (the same depth). Throws roiflow::Error on
 // empty or multi-channel inputs, mixed depths or a non-positive scale.
 TemplateMatch match_template(const cv::Mat& image, const cv::Mat& templ, const cv::Rect& search,
-                             const TemplateSearchParams& params = {});
+                             const TemplateSearchParams& params = {}, const MatchPrior& prior = {});
 
 // The size match_template gives `templ` at `scale`, and `templ` resized to `size` as it does
 // (area interpolation when shrinking, linear when growing): a caller that matches the same

@@ -13,6 +13,7 @@
 #include <opencv2/imgproc.hpp>
 #include "core/error.hpp"
 #include "core/text.hpp"
+#include "stages/camera_motion.hpp"
 
 namespace roiflow::stages {
 namespace {
@@ -240,6 +241,7 @@ struct Tracker::Impl {
   bool has_target = false;
   bool lost = false;
   bool camera_moves = false;
+  cv::Point2f rel_velocity;   // the target's recent motion relative to the background
   cv::Rect2f last_held;       // the target's box the last time the local treatment held it
   long long frames_lost = 0;  // frames lost in a row
   long long still_run = 0;    // frames in a row the held box held no moving pixels
@@ -414,8 +416,34 @@ bool Tracker::Impl::confirm_candidate(const TrackerInput& frame, const cv::Mat& 
 
 void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double refresh_weight) {
   const cv::Rect2f before = local.box();  // where the object was on the grid of region_flow
+  const cv::Point2f velocity_before = local.velocity();
   if (refresh_weight > 0) observe(frame, refresh_weight, true);
-  const LocalResult r = local.track({frame.gray, frame.pyramid});
+  LocalResult r = local.track({frame.gray, frame.pyramid});
+  // A camera that jumps takes the target further than its velocity predicts: once more from the
+  // frame before, predicted where the picture's own shift and the target's motion relative to
+  // the background take it.
+  if (r.lost && !lost && params.camera_retry && !previous_gray.empty()) {
+    if (const std::optional<cv::Point2f> g = camera_shift(previous_gray, frame.gray, before)) {
+      const cv::Point2f v = *g + rel_velocity;
+      const cv::Point2f change = v - velocity_before;
+      const float side = 0.5f * std::min(before.width, before.height);
+      if (change.dot(change) > std::max(4.f, side * side)) {
+        local.restart({previous_gray, nullptr}, before, v);
+        LocalResult again = local.track({frame.gray, frame.pyramid});
+        if (!again.lost) {
+          r = std::move(again);
+        } else {
+          // Not there either: the first measurement stands (the same step again, from the same
+          // state).
+          local.restart({previous_gray, nullptr}, before, velocity_before);
+          r = local.track({frame.gray, frame.pyramid});
+        }
+      }
+    }
+  }
+  if (!r.lost && r.background_known) {
+    rel_velocity = 0.5f * rel_velocity + 0.5f * (centre(r.box) - centre(before) - r.background);
+  }
   out.has_target = true;
   out.region = r.region;
   out.region_flow = r.region_flow;

@@ -62,6 +62,11 @@ struct TrackerParams {
   // (pipeline_bench TrackVsDecode: 2.3-2.6k frames/s, 2.9-3.0k at 64; the demo's AUC
   // unchanged, global activations vtest 11 -> 8, bgslibrary 8 -> 9). 1..1000.
   int observe_interval = 64;
+  // When the local treatment loses a held target, it tries once more from the frame before,
+  // predicting the target where the whole picture's shift (stages::camera_shift) and the target's
+  // motion relative to the background take it: a camera that jumps moves the target further
+  // than its velocity predicts.
+  bool camera_retry = false;
   // While the target is held, each refresh learns as much as observe_interval x held_learning
   // frames of video: the model forgets more slowly than while searching (1 / held_learning times
   // its history), so that a slow target it sees in every refresh is not learnt into the

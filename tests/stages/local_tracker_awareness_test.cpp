@@ -105,6 +105,10 @@ TEST(LocalTrackerAwareness, FollowsAThinTargetByThePixelsThatMoveWithIt) {
     LocalTrackerParams p;
     p.segment = segment;
     p.appearance_weight = 0;  // the flow alone: the appearance correction would pull it along
+    // ... and the coarse scale search (3 scales 3 % apart): the finer default one sizes the box of
+    // a lost target well enough for the wide appearance search to pull it along too.
+    p.scale_steps = 1;
+    p.scale_step = 0.03;
     LocalTracker tracker(p);
     tracker.start({scene.render(0), nullptr}, scene.box(0));
     double worst = 0;

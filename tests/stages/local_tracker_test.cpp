@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <opencv2/imgproc.hpp>
 #include <string>
@@ -174,6 +175,30 @@ TEST(LocalTracker, RestartPlacesTheObjectAgain) {
     EXPECT_FALSE(r.lost) << "frame " << i;
     EXPECT_LT(center_error(r.box, scene.box(i)), 2.0) << "frame " << i;
   }
+}
+
+TEST(LocalTracker, RestartWithTheJumpsVelocityFollowsTheJump) {
+  // What stages::Tracker's camera retry does: the step that lost the target at the jump, again
+  // from the frame before, predicted by the jump's motion.
+  const eval::TrackingScene scene(small_scene(60.0, 0.0));
+  const int jump = scene.jump_frame();
+  LocalTracker tracker;
+  tracker.start(frame_of(scene.render(0)), scene.box(0));
+  for (int i = 1; i < jump; ++i)
+    tracker.track(frame_of(scene.render(i)));
+  const cv::Rect2f before = tracker.box();
+  ASSERT_TRUE(tracker.track(frame_of(scene.render(jump))).lost);
+  const cv::Point2f shift = (scene.box(jump).tl() - scene.box(jump - 1).tl());
+  tracker.restart(frame_of(scene.render(jump - 1)), before, shift);
+  EXPECT_EQ(tracker.velocity(), shift);
+  const LocalResult r = tracker.track(frame_of(scene.render(jump)));
+  EXPECT_FALSE(r.lost) << to_string(r.reason);
+  EXPECT_LT(center_error(r.box, scene.box(jump)), 2.0);
+  EXPECT_NE(error_message([&] {
+              tracker.restart(frame_of(scene.render(jump)), before,
+                              {std::numeric_limits<float>::quiet_NaN(), 0.f});
+            }).find("finite"),
+            std::string::npos);
 }
 
 TEST(LocalTracker, LosesAnObjectReplacedByFlatGray) {

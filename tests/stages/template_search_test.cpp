@@ -27,6 +27,35 @@ TEST(TemplateSearch, FindsAPatchWhereItWasCut) {
   EXPECT_GT(m.score, 0.99);
 }
 
+TEST(TemplateSearch, APriorPicksTheNearerOfTwoEqualMatches) {
+  cv::Mat image = texture({320, 240}, 9);
+  const cv::Mat patch = texture({30, 40}, 10);
+  patch.copyTo(image(cv::Rect(40, 50, 30, 40)));
+  patch.copyTo(image(cv::Rect(230, 170, 30, 40)));
+  TemplateSearchParams p{{1.0}, 0};
+  MatchPrior prior{{245.f, 190.f}, 100, 0.1};  // at the second copy's centre
+  const TemplateMatch near_second =
+      match_template(image, patch, cv::Rect(0, 0, 320, 240), p, prior);
+  EXPECT_NEAR(near_second.box.x, 230, 0.5);
+  EXPECT_NEAR(near_second.box.y, 170, 0.5);
+  EXPECT_GT(near_second.score, 0.99);  // the NCC itself, not less the penalty
+  EXPECT_NEAR(near_second.ranked, near_second.score, 1e-3);
+  prior.centre = {55.f, 70.f};  // the first copy's centre
+  const TemplateMatch near_first = match_template(image, patch, cv::Rect(0, 0, 320, 240), p, prior);
+  EXPECT_NEAR(near_first.box.x, 40, 0.5);
+  EXPECT_NEAR(near_first.box.y, 50, 0.5);
+  // Coarse to fine honours the prior too.
+  p.coarse_side = 12;
+  const TemplateMatch coarse = match_template(image, patch, cv::Rect(0, 0, 320, 240), p, prior);
+  EXPECT_NEAR(coarse.box.x, 40, 0.5);
+  EXPECT_NEAR(coarse.box.y, 50, 0.5);
+  prior.penalty = -1;
+  EXPECT_NE(error_message([&] {
+              match_template(image, patch, cv::Rect(0, 0, 320, 240), p, prior);
+            }).find("prior"),
+            std::string::npos);
+}
+
 TEST(TemplateSearch, CoarseToFineFindsWhatTheFullSearchFinds) {
   const cv::Mat image = texture({400, 300}, 4);
   const cv::Rect where(37, 201, 90, 70);
