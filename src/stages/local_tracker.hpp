@@ -53,7 +53,9 @@ struct LocalTrackerParams {
   double appearance_weight = 0.5;  // how far the box moves to the appearance match, [0, 1]
   double search = 0.15;            // appearance search radius, as a share of the box's shorter
                                    // side (at least 3 pixels of the match level), (0, 2]
-  double scale_step = 0.0125;      // relative step between the matched scales, (0, 0.5)
+  double scale_step = 0.0125;      // relative step between the matched scales, (0, 0.5): finer
+                                   // steps over a wider range than the paper's 3 scales 3 % apart
+                                   // size small targets better (docs/BENCHMARK.md)
   int scale_steps = 5;             // scales matched on each side of the measured one, 0..10
   int match_side = 20;             // the shorter side the template is matched at (the finest
                                    // pyramid level where the object is at least this size), 8..256
@@ -83,8 +85,10 @@ struct LocalTrackerParams {
   bool follow_lost = true;   // while lost, the box follows the flow where its checks pass (the
                              // target seen from a side no look shows, most often) instead of
                              // coasting; still reported lost until a look confirms it
-  double lost_prior = 0.05;  // while lost, a match at the search's edge ranks this much NCC below
-                             // an equal one at the prediction (template_search's prior), [0, 1]
+  double lost_prior = 0;     // while lost, a match at the search's edge ranks this much NCC below
+                             // an equal one at the prediction (stages::MatchPrior), [0, 1]; off:
+                             // 0.05 and 0.1 moved the dev set's sequences both ways
+                             // (docs/BENCHMARK.md)
   double max_reach = 8;      // while lost, the appearance search around the coasting box widens
                              // from 2 to this many times `search`, 2..100
   void validate() const;     // throws roiflow::Error naming the bad value

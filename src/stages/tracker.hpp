@@ -66,7 +66,7 @@ struct TrackerParams {
   // predicting the target where the whole picture's shift (stages::camera_shift) and the target's
   // motion relative to the background take it: a camera that jumps moves the target further
   // than its velocity predicts.
-  bool camera_retry = false;
+  bool camera_retry = true;
   // While the target is held, each refresh learns as much as observe_interval x held_learning
   // frames of video: the model forgets more slowly than while searching (1 / held_learning times
   // its history), so that a slow target it sees in every refresh is not learnt into the
