@@ -4,7 +4,8 @@
 //   build/release/bench/flow_bench --benchmark_filter=640x480
 //
 //   BM_Flow/<method>/<W>x<H>/threads:<n>   method: roiflow_paper, roiflow_accurate, roiflow_fast,
-//                                          dis_ultrafast, dis_fast, dis_medium, farneback
+//                                          roiflow_paper_l4i1, roiflow_paper_l4f1 (variants of
+//                                          paper), dis_ultrafast, dis_fast, dis_medium, farneback
 //   BM_TwoThreadBound/<paper|fast>/<W>x<H>  one pair's two-thread schedule timed on the CPU clock
 //                                          of one thread: speedup2, what two idle cores would give
 //   BM_Pyramid/<W>x<H>                     build_pyramid(frame) alone (paper preset), 1 thread
@@ -114,11 +115,24 @@ FlowFn farneback_flow() {
   };
 }
 
+roiflow::flow::LkParams paper_variant(int levels, int finest_iterations, int finest_level) {
+  roiflow::flow::LkParams p = roiflow::flow::LkParams::paper();
+  p.levels = levels;
+  p.finest_iterations = finest_iterations;
+  p.finest_level = finest_level;
+  return p;
+}
+
 const std::vector<Method>& methods() {
   static const std::vector<Method> all = {
       {"roiflow_paper", [] { return roiflow_flow(roiflow::flow::LkParams::paper()); }},
       {"roiflow_accurate", [] { return roiflow_flow(roiflow::flow::LkParams::accurate()); }},
       {"roiflow_fast", [] { return roiflow_flow(roiflow::flow::LkParams::fast()); }},
+      // Two cheaper variants of paper (docs/PERFORMANCE.md): a 4-level pyramid with 1 iteration
+      // at level 0 (3 on the others), and the paper's 3 levels x 3 iterations on levels 3..1
+      // with level 0 upsampled.
+      {"roiflow_paper_l4i1", [] { return roiflow_flow(paper_variant(4, 1, 0)); }},
+      {"roiflow_paper_l4f1", [] { return roiflow_flow(paper_variant(4, 0, 1)); }},
       {"dis_ultrafast", [] { return dis_flow(cv::DISOpticalFlow::PRESET_ULTRAFAST); }},
       {"dis_fast", [] { return dis_flow(cv::DISOpticalFlow::PRESET_FAST); }},
       {"dis_medium", [] { return dis_flow(cv::DISOpticalFlow::PRESET_MEDIUM); }},

@@ -101,6 +101,8 @@ TEST(DenseLkTest, RejectsEveryParameterOutOfRange) {
       {"levels", "7", [](LkParams& p) { p.levels = 7; }},
       {"iterations", "0", [](LkParams& p) { p.iterations = 0; }},
       {"iterations", "51", [](LkParams& p) { p.iterations = 51; }},
+      {"finest iterations", "-1", [](LkParams& p) { p.finest_iterations = -1; }},
+      {"finest iterations", "51", [](LkParams& p) { p.finest_iterations = 51; }},
       {"sigma", "-1", [](LkParams& p) { p.sigma = -1; }},
       {"sigma", "nan", [](LkParams& p) { p.sigma = std::numeric_limits<double>::quiet_NaN(); }},
       {"lambda", "0", [](LkParams& p) { p.lambda = 0; }},
