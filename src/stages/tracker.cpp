@@ -315,6 +315,8 @@ struct Tracker::Impl {
   void follow(const TrackerInput& frame, TrackerOutput& out, double refresh_weight);
   LostReason self_check(const TrackerInput& frame, const cv::Rect2f& box);
   bool confirm_candidate(const TrackerInput& frame, const cv::Mat& image, TrackerOutput& out);
+  void retry_by_camera(const TrackerInput& frame, const cv::Rect2f& before,
+                       cv::Point2f velocity_before, LocalResult& r);
 
   // The background model is only needed to find a target that was not given. `weight`: the
   // frames of video this observation stands for. `beside`: as a job of the executor, beside the
@@ -431,33 +433,36 @@ bool Tracker::Impl::confirm_candidate(const TrackerInput& frame, const cv::Mat& 
   return false;
 }
 
+// A camera that jumps takes the target further than its velocity predicts: the step that lost a
+// held target runs once more from the frame before, predicted where the picture's own shift and
+// the target's motion relative to the background take it, and replaces `r` when it holds. A
+// prediction within half the box's shorter side of the first is within the first step's reach.
+void Tracker::Impl::retry_by_camera(const TrackerInput& frame, const cv::Rect2f& before,
+                                    cv::Point2f velocity_before, LocalResult& r) {
+  if (previous_gray.empty()) return;
+  const std::optional<cv::Point2f> g = camera_shift(previous_gray, frame.gray, before);
+  if (!g) return;
+  const cv::Point2f v = *g + rel_velocity;
+  const cv::Point2f change = v - velocity_before;
+  const float side = 0.5f * std::min(before.width, before.height);
+  if (change.dot(change) <= std::max(4.f, side * side)) return;
+  local.restart({previous_gray, nullptr}, before, v);
+  LocalResult again = local.track({frame.gray, frame.pyramid});
+  if (!again.lost) {
+    r = std::move(again);
+    return;
+  }
+  // Not there either: the first measurement stands (the same step again, from the same state).
+  local.restart({previous_gray, nullptr}, before, velocity_before);
+  r = local.track({frame.gray, frame.pyramid});
+}
+
 void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double refresh_weight) {
   const cv::Rect2f before = local.box();  // where the object was on the grid of region_flow
   const cv::Point2f velocity_before = local.velocity();
   if (refresh_weight > 0) observe(frame, refresh_weight, true);
   LocalResult r = local.track({frame.gray, frame.pyramid});
-  // A camera that jumps takes the target further than its velocity predicts: once more from the
-  // frame before, predicted where the picture's own shift and the target's motion relative to
-  // the background take it.
-  if (r.lost && !lost && params.camera_retry && !previous_gray.empty()) {
-    if (const std::optional<cv::Point2f> g = camera_shift(previous_gray, frame.gray, before)) {
-      const cv::Point2f v = *g + rel_velocity;
-      const cv::Point2f change = v - velocity_before;
-      const float side = 0.5f * std::min(before.width, before.height);
-      if (change.dot(change) > std::max(4.f, side * side)) {
-        local.restart({previous_gray, nullptr}, before, v);
-        LocalResult again = local.track({frame.gray, frame.pyramid});
-        if (!again.lost) {
-          r = std::move(again);
-        } else {
-          // Not there either: the first measurement stands (the same step again, from the same
-          // state).
-          local.restart({previous_gray, nullptr}, before, velocity_before);
-          r = local.track({frame.gray, frame.pyramid});
-        }
-      }
-    }
-  }
+  if (r.lost && !lost && params.camera_retry) retry_by_camera(frame, before, velocity_before, r);
   if (!r.lost && r.background_known) {
     rel_velocity = 0.5f * rel_velocity + 0.5f * (centre(r.box) - centre(before) - r.background);
   }
