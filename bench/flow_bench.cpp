@@ -4,7 +4,10 @@
 //   build/release/bench/flow_bench --benchmark_filter=640x480
 //
 //   BM_Flow/<method>/<W>x<H>/threads:<n>   method: roiflow_paper, roiflow_accurate, roiflow_fast,
-//                                          dis_ultrafast, dis_fast, dis_medium, farneback
+//                                          roiflow_paper_l4i1, roiflow_paper_l4i1r,
+//                                          roiflow_paper_l4f1r (variants of paper, see
+//                                          docs/PERFORMANCE.md), dis_ultrafast, dis_fast,
+//                                          dis_medium, farneback
 //   BM_TwoThreadBound/<paper|fast>/<W>x<H>  one pair's two-thread schedule timed on the CPU clock
 //                                          of one thread: speedup2, what two idle cores would give
 //   BM_Pyramid/<W>x<H>                     build_pyramid(frame) alone (paper preset), 1 thread
@@ -114,11 +117,31 @@ FlowFn farneback_flow() {
   };
 }
 
+// paper with `levels`, `finest_iterations`, `finest_level`; robust_scale > 0 also masks the
+// samples outside the frame.
+roiflow::flow::LkParams paper_variant(int levels, int finest_iterations, int finest_level,
+                                      double robust_scale) {
+  roiflow::flow::LkParams p = roiflow::flow::LkParams::paper();
+  p.levels = levels;
+  p.finest_iterations = finest_iterations;
+  p.finest_level = finest_level;
+  p.robust_scale = robust_scale;
+  p.mask_outside = robust_scale > 0;
+  return p;
+}
+
 const std::vector<Method>& methods() {
   static const std::vector<Method> all = {
       {"roiflow_paper", [] { return roiflow_flow(roiflow::flow::LkParams::paper()); }},
       {"roiflow_accurate", [] { return roiflow_flow(roiflow::flow::LkParams::accurate()); }},
       {"roiflow_fast", [] { return roiflow_flow(roiflow::flow::LkParams::fast()); }},
+      // Cheaper variants of paper (docs/PERFORMANCE.md): a 4-level pyramid with 1 iteration at
+      // level 0 (3 on the others); the same with samples outside the frame masked and Cauchy
+      // weights (r); the paper's 3 levels x 3 iterations on levels 3..1 with level 0 upsampled,
+      // masked and weighted.
+      {"roiflow_paper_l4i1", [] { return roiflow_flow(paper_variant(4, 1, 0, 0.0)); }},
+      {"roiflow_paper_l4i1r", [] { return roiflow_flow(paper_variant(4, 1, 0, 0.04)); }},
+      {"roiflow_paper_l4f1r", [] { return roiflow_flow(paper_variant(4, 0, 1, 0.02)); }},
       {"dis_ultrafast", [] { return dis_flow(cv::DISOpticalFlow::PRESET_ULTRAFAST); }},
       {"dis_fast", [] { return dis_flow(cv::DISOpticalFlow::PRESET_FAST); }},
       {"dis_medium", [] { return dis_flow(cv::DISOpticalFlow::PRESET_MEDIUM); }},

@@ -629,6 +629,7 @@ nlohmann::ordered_json params_json(const flow::LkParams& params) {
   return {{"patch", params.patch},
           {"levels", params.levels},
           {"iterations", params.iterations},
+          {"finest_iterations", params.finest_iterations},
           {"sigma", params.sigma},
           {"derivative", flow::to_string(params.derivative)},
           {"lambda", params.lambda},

@@ -84,10 +84,10 @@ LevelPlan plan_levels(cv::Size size, const LkParams& params, const FlowOptions& 
   // the derivative stencil: computing on a margin of this many pixels per iteration makes a
   // region's flow equal the whole frame's flow inside the region (up to rounding).
   const int reach = win.reach() + 2;
-  const int margin =
-      options.context >= 0
-          ? options.context
-          : params.iterations * reach + std::max(params.level_median, params.final_median) / 2;
+  const int margin = options.context >= 0
+                         ? options.context
+                         : std::max(params.iterations, params.finest_iterations) * reach +
+                               std::max(params.level_median, params.final_median) / 2;
   plan.comp.resize(plan.top);
   cv::Rect need = region;
   for (int l = 0; l < plan.top; ++l) {
@@ -232,14 +232,15 @@ void flow_from_pyramids(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkPar
     }
     const LevelProblem p = level_problem(pyr_t.levels[l], pyr_t1.levels[l], c, params);
     const bool finest = l == plan.finest;
+    const int iterations = params.iterations_at(l, plan.finest);
     if (finest && direct) {
-      iterate_level(p, input, ws.u[l], ws.v[l], &result.confidence, params.iterations, exec,
-                    ws.scratch, &result.flow);
+      iterate_level(p, input, ws.u[l], ws.v[l], &result.confidence, iterations, exec, ws.scratch,
+                    &result.flow);
       result.region = region;
       return;
     }
-    iterate_level(p, input, ws.u[l], ws.v[l], finest ? &ws.confidence : nullptr, params.iterations,
-                  exec, ws.scratch);
+    iterate_level(p, input, ws.u[l], ws.v[l], finest ? &ws.confidence : nullptr, iterations, exec,
+                  ws.scratch);
     cv::Mat u = view(ws.u[l], c.size()), v = view(ws.v[l], c.size());
     median_filter(u, v, finest ? params.final_median : params.level_median, exec);
   }

@@ -38,6 +38,9 @@ struct LkParams {
   int patch = 10;      // window side in pixels, 3..31, even sizes allowed (see above)
   int levels = 3;      // pyramid levels, 1..6 (fewer when the image is small); 0 = auto
   int iterations = 3;  // refinement iterations per level, 1..50
+  // Iterations at the finest level LK runs on (0 = `iterations`), 0..50: the finest level holds
+  // most of the pixels, so fewer iterations there cut most of the time (docs/PERFORMANCE.md).
+  int finest_iterations = 0;
   double sigma = 0.5;  // pretreatment Gaussian sigma in pixels, 0 = off
   Derivative derivative = Derivative::HornSchunck;
   // Tikhonov weight, in (intensity/pixel)^2 with intensities in [0, 1]: it keeps textureless
@@ -70,7 +73,11 @@ struct LkParams {
   // levels get the upsampled flow. 0..kMaxLevels - 1.
   int finest_level = 0;
 
-  static LkParams paper();     // patch 10, levels 3, iterations 3, Horn–Schunck
+  static LkParams paper();  // patch 10, levels 3, iterations 3, Horn–Schunck
+  // Iterations at `level` when LK's finest level is `finest`.
+  int iterations_at(int level, int finest) const {
+    return level == finest && finest_iterations > 0 ? finest_iterations : iterations;
+  }
   static LkParams accurate();  // tuned for the lowest error on real data
   static LkParams fast();      // realtime with large motions: search, fusion, LK to level 1
   // "paper", "accurate" or "fast"; throws roiflow::Error naming the unknown preset.

@@ -73,6 +73,10 @@ void LkParams::validate() const {
   if (iterations < 1 || iterations > 50) {
     fail("iterations must be in 1..50, got " + std::to_string(iterations));
   }
+  if (finest_iterations < 0 || finest_iterations > 50) {
+    fail("finest iterations must be in 0..50 (0 = iterations), got " +
+         std::to_string(finest_iterations));
+  }
   if (!(sigma >= 0.0 && sigma <= 20.0))
     fail("sigma must be in [0, 20], got " + std::to_string(sigma));
   if (!(lambda > 0.0 && lambda <= 1.0)) {

@@ -444,6 +444,51 @@ TEST(DenseLkTest, AFinestLevelAboveZeroGivesTheCoarserFlowUpsampled) {
   }
 }
 
+// finest_iterations changes the iterations of the finest LK level only: equal to `iterations`
+// it is the default, on one level it is `iterations`, and on several levels the coarser ones
+// keep theirs (the flow differs from both uniform counts). The region's margin covers the
+// larger count, so a region's flow stays the whole frame's.
+TEST(DenseLkTest, FinestIterationsApplyToTheFinestLevelOnly) {
+  const Scene s = make_scene(SceneKind::Rotation, kSize, 4);
+  const LkParams paper = LkParams::paper();
+  const FlowResult base = dense_flow(s.frame0, s.frame1, paper);
+  LkParams same = paper;
+  same.finest_iterations = paper.iterations;
+  EXPECT_EQ(max_abs_diff(dense_flow(s.frame0, s.frame1, same).flow, base.flow), 0.0);
+
+  LkParams one_level = paper;
+  one_level.levels = 1;
+  one_level.iterations = 5;
+  one_level.finest_iterations = 2;
+  LkParams two_iterations = one_level;
+  two_iterations.iterations = 2;
+  two_iterations.finest_iterations = 0;
+  EXPECT_EQ(max_abs_diff(dense_flow(s.frame0, s.frame1, one_level).flow,
+                         dense_flow(s.frame0, s.frame1, two_iterations).flow),
+            0.0);
+
+  LkParams cheap = paper;
+  cheap.finest_iterations = 1;
+  LkParams uniform_one = paper;
+  uniform_one.iterations = 1;
+  const FlowResult r = dense_flow(s.frame0, s.frame1, cheap);
+  EXPECT_GT(max_abs_diff(r.flow, base.flow), 1e-3);
+  EXPECT_GT(max_abs_diff(r.flow, dense_flow(s.frame0, s.frame1, uniform_one).flow), 1e-3);
+  EXPECT_EQ(cheap.iterations_at(0, 0), 1);
+  EXPECT_EQ(cheap.iterations_at(1, 0), paper.iterations);
+  EXPECT_EQ(cheap.iterations_at(1, 1), 1);
+  EXPECT_LT(interior_errors(r.flow, s.flow).epe, 1.2 * interior_errors(base.flow, s.flow).epe);
+
+  LkParams more = paper;
+  more.iterations = 1;
+  more.finest_iterations = 6;
+  const FlowResult whole = dense_flow(s.frame0, s.frame1, more);
+  FlowOptions options;
+  options.region = cv::Rect(117, 83, 64, 48);
+  const FlowResult part = dense_flow(s.frame0, s.frame1, more, options);
+  EXPECT_LT(max_abs_diff(part.flow, whole.flow(options.region)), 0.03);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Initial motion, confidence.
 

@@ -42,6 +42,16 @@ LkParams with_derivative(LkParams p, Derivative d) {
   return p;
 }
 
+// paper on 4 levels with 1 iteration at the finest (docs/PERFORMANCE.md, variant l4i1r).
+LkParams paper_l4i1r() {
+  LkParams p = LkParams::paper();
+  p.levels = 4;
+  p.finest_iterations = 1;
+  p.mask_outside = true;
+  p.robust_scale = 0.04;
+  return p;
+}
+
 struct NamedParams {
   const char* name;
   LkParams params;
@@ -50,6 +60,7 @@ struct NamedParams {
 std::vector<NamedParams> configurations() {
   return {{"paper", LkParams::paper()},
           {"paper patch 9", with_patch(LkParams::paper(), 9)},
+          {"paper l4i1r", paper_l4i1r()},
           {"accurate", LkParams::accurate()},
           {"accurate patch 11 scharr",
            with_derivative(with_patch(LkParams::accurate(), 11), Derivative::Scharr)}};
@@ -101,6 +112,8 @@ TEST(DenseLkTest, RejectsEveryParameterOutOfRange) {
       {"levels", "7", [](LkParams& p) { p.levels = 7; }},
       {"iterations", "0", [](LkParams& p) { p.iterations = 0; }},
       {"iterations", "51", [](LkParams& p) { p.iterations = 51; }},
+      {"finest iterations", "-1", [](LkParams& p) { p.finest_iterations = -1; }},
+      {"finest iterations", "51", [](LkParams& p) { p.finest_iterations = 51; }},
       {"sigma", "-1", [](LkParams& p) { p.sigma = -1; }},
       {"sigma", "nan", [](LkParams& p) { p.sigma = std::numeric_limits<double>::quiet_NaN(); }},
       {"lambda", "0", [](LkParams& p) { p.lambda = 0; }},

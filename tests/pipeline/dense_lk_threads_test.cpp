@@ -35,6 +35,16 @@ LkParams with_derivative(LkParams p, Derivative d) {
   return p;
 }
 
+// paper on 4 levels with 1 iteration at the finest (docs/PERFORMANCE.md, variant l4i1r).
+LkParams paper_l4i1r() {
+  LkParams p = LkParams::paper();
+  p.levels = 4;
+  p.finest_iterations = 1;
+  p.mask_outside = true;
+  p.robust_scale = 0.04;
+  return p;
+}
+
 struct NamedParams {
   const char* name;
   LkParams params;
@@ -43,6 +53,7 @@ struct NamedParams {
 std::vector<NamedParams> configurations() {
   return {{"paper", LkParams::paper()},
           {"paper patch 9", with_patch(LkParams::paper(), 9)},
+          {"paper l4i1r", paper_l4i1r()},
           {"accurate", LkParams::accurate()},
           {"accurate patch 11 scharr",
            with_derivative(with_patch(LkParams::accurate(), 11), Derivative::Scharr)}};
