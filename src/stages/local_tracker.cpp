@@ -225,9 +225,7 @@ double LocalTracker::Impl::backward_check(const cv::Rect& object, cv::Point2f ro
   opt.initial_motion = -rough;
   inliers.clear();
   if (opt.region.empty()) return 1e9;
-  flow::LkParams back_lk = params.lk;
-  back_lk.levels = std::min(params.lk.levels, params.fb_levels);
-  flow::dense_flow(view_cur, view_prev, back_lk, backward, opt, executor);
+  backward_lk.calc(view_cur, view_prev, backward, opt);
   const cv::Point2f back_origin(static_cast<float>(backward.region.x + origin.x),
                                 static_cast<float>(backward.region.y + origin.y));
   const float limit2 = static_cast<float>(params.fb_threshold * params.fb_threshold);
@@ -273,8 +271,12 @@ LocalResult LocalTracker::Impl::track(const LocalFrame& in) {
   opt.initial_motion = velocity;
   opt.context = params.lk_context;
   opt.finest_level = r.level;
-  flow::dense_flow(view_prev, view_cur, params.lk, forward, opt, executor);
-  r.region_flow = forward.flow.clone();
+  // The result shares the forward flow's buffer; it is written again only once nobody else
+  // holds it (a sink may still hold the last one).
+  if (forward.flow.u != nullptr && CV_XADD(&forward.flow.u->refcount, 0) > 1)
+    forward.flow.release();
+  forward_lk.calc(view_prev, view_cur, forward, opt);
+  r.region_flow = forward.flow;
   const cv::Point2f rough = sample_object(object, r.region, r.texture);
   r.fb_error = backward_check(object, rough, origin, part, r.level);
   r.inliers = static_cast<double>(inliers.size()) / static_cast<double>(from.size());
@@ -356,6 +358,10 @@ LocalTracker::LocalTracker(const LocalTrackerParams& params, const Executor* exe
   params.validate();
   impl_->params = params;
   impl_->executor = executor;
+  impl_->forward_lk = flow::DenseLK(params.lk, executor);
+  flow::LkParams back_lk = params.lk;
+  back_lk.levels = std::min(params.lk.levels, params.fb_levels);
+  impl_->backward_lk = flow::DenseLK(back_lk, executor);
 }
 
 LocalTracker::~LocalTracker() = default;

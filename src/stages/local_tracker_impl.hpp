@@ -20,6 +20,7 @@
 #include "core/error.hpp"
 #include "core/text.hpp"
 #include "stages/local_tracker.hpp"
+#include "stages/select_impl.hpp"
 #include "stages/template_search.hpp"
 
 namespace roiflow::stages {
@@ -47,11 +48,9 @@ inline cv::Rect grown(const cv::Rect& r, int m) {
   return {r.x - m, r.y - m, r.width + 2 * m, r.height + 2 * m};
 }
 
-// Median by partial sort; reorders `v`, which must not be empty.
+// The median (the element of rank size / 2); reorders `v`, which must not be empty.
 inline float median(std::vector<float>& v) {
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
+  return kth_smallest(v.data(), v.size(), v.size() / 2);
 }
 
 // Bilinear sample of a CV_32FC2 field at (x, y), false outside its last full 2x2 cell.
@@ -200,8 +199,10 @@ struct LocalTracker::Impl {
   double moving = 0;    // recent speed relative to the background (running mean)
   bool built = false;   // frame t's part is in next_part (this step)
 
-  // Buffers reused from frame to frame.
+  // Buffers reused from frame to frame: the forward and backward LK keep their workspaces (a
+  // dense_flow call would allocate and zero one every time).
   flow::Pyramid view_prev, view_cur, view_next;
+  flow::DenseLK forward_lk, backward_lk;
   flow::FlowResult forward;
   flow::FlowResult backward;
   std::vector<cv::Point2f> from, to;

@@ -4,6 +4,8 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
 #include <deque>
 #include <optional>
 #include <string>
@@ -13,6 +15,7 @@
 #include <opencv2/imgproc.hpp>
 #include "core/error.hpp"
 #include "core/text.hpp"
+#include "stages/select_impl.hpp"
 
 namespace roiflow::stages {
 namespace {
@@ -34,6 +37,23 @@ cv::Rect2f box_at(cv::Point2f c, cv::Size2f s) {
   return {c.x - 0.5f * s.width, c.y - 0.5f * s.height, s.width, s.height};
 }
 
+// How many pixels of two 8-bit images of one size differ by more than `level` grey levels (as
+// countNonZero(absdiff(a, b) > level), without the two images it makes).
+double changed_pixels(const cv::Mat& a, const cv::Mat& b, double level) {
+  // For whole grey levels d, d > level exactly when d > floor(level).
+  const int above = static_cast<int>(std::floor(level));
+  long long n = 0;
+  for (int y = 0; y < a.rows; ++y) {
+    const std::uint8_t* pa = a.ptr<std::uint8_t>(y);
+    const std::uint8_t* pb = b.ptr<std::uint8_t>(y);
+    int row = 0;
+    for (int x = 0; x < a.cols; ++x)
+      row += std::abs(static_cast<int>(pa[x]) - static_cast<int>(pb[x])) > above;
+    n += row;
+  }
+  return static_cast<double>(n);
+}
+
 // Median flow magnitude over a grid of the region's pixels that lie outside the object's box:
 // how fast the background moves, or -1 when the region holds too little of it to tell.
 double background_motion(const cv::Mat& flow, const cv::Rect& region, const cv::Rect2f& box) {
@@ -51,9 +71,7 @@ double background_motion(const cv::Mat& flow, const cv::Rect& region, const cv::
     }
   }
   if (speeds.size() < 16) return -1;
-  const auto mid = speeds.begin() + static_cast<std::ptrdiff_t>(speeds.size() / 2);
-  std::nth_element(speeds.begin(), mid, speeds.end());
-  return *mid;
+  return detail::kth_smallest(speeds.data(), speeds.size(), speeds.size() / 2);
 }
 
 // A moving object found by background subtraction arrives with its recent past: the blob holds
@@ -372,11 +390,10 @@ LostReason Tracker::Impl::self_check(const TrackerInput& frame, const cv::Rect2f
   }
   const cv::Rect r = cv::Rect(inside) & cv::Rect(cv::Point(), size);
   if (r.empty()) return LostReason::Collapsed;
-  cv::Mat diff;
   // Against the frame still_baseline frames back (the oldest kept when fewer have been seen).
   const std::size_t back = std::min(recent_gray.size(), static_cast<std::size_t>(kStillBaseline));
-  cv::absdiff(frame.gray(r), recent_gray[recent_gray.size() - back](r), diff);
-  const double moving = cv::countNonZero(diff > params.still_level);
+  const double moving =
+      changed_pixels(frame.gray(r), recent_gray[recent_gray.size() - back](r), params.still_level);
   still_run = moving <= params.still_share * r.area() ? still_run + 1 : 0;
   return still_run >= params.still_frames ? LostReason::Still : LostReason::Found;
 }
