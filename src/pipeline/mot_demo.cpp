@@ -74,8 +74,10 @@ MotDemoResult run_mot_demo(const MotDemoOptions& options) {
   }
   const std::vector<eval::MotBox> truth = scene.ground_truth();
   eval::write_mot(result.ground_truth, truth);
-  // Scored from the file, as `roiflow score --mot` reads it (2-decimal boxes).
-  result.score = eval::score_mot(eval::read_mot(result.mot, "tracker output"), truth);
+  // Scored from the two files, as `roiflow score --mot` reads them (2-decimal boxes: an IoU at
+  // 0.5 may fall either side of it with the exact boxes).
+  result.score = eval::score_mot(eval::read_mot(result.mot, "tracker output"),
+                                 eval::read_mot(result.ground_truth, "ground truth"));
 
   const eval::MotScore& s = result.score;
   result.summary = run.summary;

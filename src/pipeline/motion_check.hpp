@@ -25,7 +25,14 @@
 namespace roiflow::pipeline {
 
 struct MotionCheckParams {
-  stages::MotionDetectorParams detector;
+  // The check's own model of moving pixels: OpenCV's MOG2 background (ratio 0.9, which calls
+  // fewer pixels moving than the tracker's), so that the check does not follow the tracker's
+  // tuning.
+  stages::MotionDetectorParams detector = [] {
+    stages::MotionDetectorParams p;
+    p.background_ratio = 0.9;
+    return p;
+  }();
   double still_share = 0.02;  // a box with at most this share of moving pixels has none
   double min_side = 8;        // pixels
   long long max_run = 30;     // frames

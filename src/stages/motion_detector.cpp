@@ -31,11 +31,19 @@ void MotionDetectorParams::validate() const {
   if (close_h < 0 || close_h > 64) fail("close_h must be in 0..64, got " + number_text(close_h));
   if (!(join_gap >= 0 && join_gap <= 2))
     fail("join_gap must be in [0, 2], got " + number_text(join_gap));
+  if (change_frames < 1 || change_frames > 1000)
+    fail("change_frames must be in 1..1000, got " + number_text(change_frames));
+  if (!(change_level > 0 && change_level < 255))
+    fail("change_level must be in (0, 255), got " + number_text(change_level));
+  if (!(background_ratio > 0 && background_ratio <= 1))
+    fail("background_ratio must be in (0, 1], got " + number_text(background_ratio));
   if (!(merge_overlap > 0 && merge_overlap <= 1))
     fail("merge_overlap must be in (0, 1], got " + number_text(merge_overlap));
 }
 
-double Foreground::moving_share(const cv::Rect2f& box) const {
+namespace {
+
+double share_of(const cv::Mat& integral, const cv::Mat& mask, int scale, const cv::Rect2f& box) {
   if (integral.empty() || !(box.width > 0) || !(box.height > 0)) return 0;
   const double s = scale;
   const int x0 = std::clamp(static_cast<int>(std::floor(box.x / s)), 0, mask.cols);
@@ -48,11 +56,22 @@ double Foreground::moving_share(const cv::Rect2f& box) const {
   return static_cast<double>(sum) / (static_cast<double>(x1 - x0) * (y1 - y0));
 }
 
+}  // namespace
+
+double Foreground::moving_share(const cv::Rect2f& box) const {
+  return share_of(integral, mask, scale, box);
+}
+
+double Foreground::changed_share(const cv::Rect2f& box) const {
+  return changed.empty() ? 1.0 : share_of(changed, mask, scale, box);
+}
+
 struct MotionDetector::Impl {
   cv::Ptr<cv::BackgroundSubtractorMOG2> model;
   cv::Size frame_size;
   int scale = 1;
   cv::Mat small, raw;
+  std::vector<cv::Mat> grays;  // the last change_frames + 1 gray frames (model resolution), a ring
   long long observed = 0;
 };
 
@@ -64,6 +83,7 @@ MotionDetector::MotionDetector(const MotionDetectorParams& params)
   impl_->model =
       cv::createBackgroundSubtractorMOG2(params_.history, params_.var_threshold, params_.shadows);
   impl_->model->setShadowThreshold(params_.shadow_threshold);
+  impl_->model->setBackgroundRatio(params_.background_ratio);
 }
 
 Foreground MotionDetector::observe(const cv::Mat& image) {
@@ -103,6 +123,24 @@ Foreground MotionDetector::observe(const cv::Mat& image) {
   cv::Mat ones;
   cv::threshold(fg.mask, ones, 0, 1, cv::THRESH_BINARY);
   cv::integral(ones, fg.integral, CV_32S);
+  // Changed pixels: against the frame change_frames back (a ring of gray frames).
+  const std::size_t ring = static_cast<std::size_t>(params_.change_frames) + 1;
+  if (s.grays.size() != ring) s.grays.assign(ring, cv::Mat());
+  cv::Mat& gray =
+      s.grays[static_cast<std::size_t>((s.observed - 1) % static_cast<long long>(ring))];
+  if (input->channels() == 3) {
+    cv::cvtColor(*input, gray, cv::COLOR_BGR2GRAY);
+  } else {
+    input->copyTo(gray);
+  }
+  if (s.observed > params_.change_frames) {
+    const cv::Mat& old = s.grays[static_cast<std::size_t>((s.observed - 1 - params_.change_frames) %
+                                                          static_cast<long long>(ring))];
+    cv::Mat diff;
+    cv::absdiff(gray, old, diff);
+    cv::threshold(diff, diff, params_.change_level, 1, cv::THRESH_BINARY);
+    cv::integral(diff, fg.changed, CV_32S);
+  }
   return fg;
 }
 
@@ -117,18 +155,23 @@ bool stacked(const cv::Rect2f& a, const cv::Rect2f& b, double join_gap) {
 }
 
 // Splits the component `label` over `box` (work resolution) at valleys of its column profile of
-// moving pixels (`mask`, before the closing bridged the gaps between neighbours); appends the
-// parts' tight boxes.
+// moving pixels (`mask`, before the closing bridged the gaps between neighbours: each column's
+// extent from its first to its last moving pixel); appends the parts' tight boxes.
 void split_blob(const cv::Mat& labels, const cv::Mat& mask, int label, cv::Rect box, double valley,
                 double min_part_share, int depth, std::vector<cv::Rect>& out) {
-  std::vector<int> cols(static_cast<std::size_t>(box.width), 0);
+  // Per column, the rows from its first to its last moving pixel: a hole inside an object (a
+  // window, a patch the model takes for background) leaves its column's extent whole and makes
+  // no valley; the background between two objects does.
+  std::vector<int> first(static_cast<std::size_t>(box.width), -1), cols(first.size(), 0);
   int top = box.br().y, bottom = box.y - 1, left = box.br().x, right = box.x - 1;
   for (int y = box.y; y < box.br().y; ++y) {
     const int* row = labels.ptr<int>(y);
     const std::uint8_t* m = mask.ptr<std::uint8_t>(y);
     for (int x = box.x; x < box.br().x; ++x) {
       if (row[x] != label || m[x] == 0) continue;
-      ++cols[static_cast<std::size_t>(x - box.x)];
+      const auto c = static_cast<std::size_t>(x - box.x);
+      if (first[c] < 0) first[c] = y;
+      cols[c] = y - first[c] + 1;
       top = std::min(top, y);
       bottom = std::max(bottom, y);
       left = std::min(left, x);

@@ -29,6 +29,13 @@ namespace roiflow::stages {
 struct MotionDetectorParams {
   int history = 500;              // frames the background model remembers (MOG2 history), >= 2
   double var_threshold = 16;      // MOG2's squared Mahalanobis distance to call a pixel moving, > 0
+  int change_frames = 4;          // Foreground::changed compares with this many frames back, >= 1
+  double change_level = 25;       // gray levels (model resolution) a changed pixel differs by, > 0
+  double background_ratio = 0.5;  // MOG2's background: its heaviest modes that together hold this
+                                  // share of the recent frames, (0, 1]. OpenCV's 0.9 takes for
+                                  // background any colour seen 10% of the time: the body of a
+                                  // slow or long vehicle, and early on (when the model learns
+                                  // fast) the back of every moving object
   int work_width = 384;           // the model works on frames shrunk by the whole factor that
                                   // brings them nearest this width; 0 = full resolution
   bool shadows = true;            // MOG2 labels shadows, which then count as background
@@ -59,10 +66,17 @@ struct Foreground {
   cv::Size frame_size;     // full resolution
   cv::Mat mask;            // CV_8U, 255 = moving (shadows are background)
   cv::Mat integral;        // CV_32S integral of mask / 255
+  // CV_32S integral of the pixels (model resolution) whose gray level changed by more than
+  // MotionDetectorParams::change_level since `change_frames` frames back; empty until then.
+  // The model's foreground also holds ghosts: background that an object uncovered after
+  // standing in it (or since the first frame); a ghost does not change.
+  cv::Mat changed;
 
   // Share of moving pixels inside `box` (full-resolution pixels, clipped to the frame); 0 for
   // an empty or outside box.
   double moving_share(const cv::Rect2f& box) const;
+  // Share of changed pixels inside `box`; 1 while `changed` is empty (nothing to tell).
+  double changed_share(const cv::Rect2f& box) const;
   bool empty() const { return mask.empty(); }
 };
 

@@ -126,6 +126,8 @@ void MultiTrackerParams::validate() const {
     fail("min_inliers must be in [0, 1), got " + number_text(min_inliers));
   if (!(min_moving >= 0 && min_moving < 1))
     fail("min_moving must be in [0, 1), got " + number_text(min_moving));
+  if (!(min_changed >= 0 && min_changed < 1))
+    fail("min_changed must be in [0, 1), got " + number_text(min_changed));
   if (!(gate_iou >= 0 && gate_iou < 1))
     fail("gate_iou must be in [0, 1), got " + number_text(gate_iou));
   if (min_hits < 1) fail("min_hits must be >= 1, got " + number_text(min_hits));
@@ -423,7 +425,7 @@ void find_merges(const TrackSet& s, const std::vector<cv::Rect2f>& guess,
 // object, its detection or -1.
 std::vector<int> assign_detections(const TrackSet& s, const std::vector<cv::Rect2f>& guess,
                                    const std::vector<Detection>& detections,
-                                   const std::vector<char>& merged,
+                                   const std::vector<char>& still, const std::vector<char>& merged,
                                    const std::vector<char>& in_merge,
                                    const MultiTrackerParams& params) {
   const std::size_t n = s.tracks.size(), nd = detections.size();
@@ -443,6 +445,8 @@ std::vector<int> assign_detections(const TrackSet& s, const std::vector<cv::Rect
       // may hold it as a ghost).
       const double gate =
           s.tracks[rows[r]].known ? std::max(0.5, params.gate_iou) : params.gate_iou;
+      // A still detection (a ghost) measures no object.
+      if (still[cols[c]]) continue;
       if (o > gate) cost[r * cols.size() + c] = 1.0 - o + tentative;
     }
   }
@@ -474,7 +478,8 @@ bool correct_tracks(TrackSet& s, bool first, const LkMeasures& lk, const std::ve
       ++t.hits;
     } else {
       if (t.id == 0) t.hits = -1;  // a tentative object must be seen in consecutive frames
-      if (lk.ok[i] && (t.known || fg.moving_share(lk.box[i]) >= params.min_moving)) {
+      if (lk.ok[i] && (t.known || (fg.moving_share(lk.box[i]) >= params.min_moving &&
+                                   fg.changed_share(lk.box[i]) >= params.min_changed))) {
         t.filter.correct_centre((lk.box[i].tl() + lk.box[i].br()) * 0.5f, lk.box[i].height);
         measured = true;
       }
@@ -485,7 +490,10 @@ bool correct_tracks(TrackSet& s, bool first, const LkMeasures& lk, const std::ve
     }
     t.lost = measured ? 0 : t.lost + 1;
     t.box = t.filter.box();
-    t.still = fg.empty() || fg.moving_share(t.box) >= params.min_moving ? 0 : t.still + 1;
+    t.still = fg.empty() || (fg.moving_share(t.box) >= params.min_moving &&
+                             fg.changed_share(t.box) >= params.min_changed)
+                  ? 0
+                  : t.still + 1;
     if (t.id != 0 && t.lost > 0) any_lost = true;
   }
   return any_lost;
@@ -528,9 +536,10 @@ void end_and_confirm(TrackSet& s, cv::Size size, const MultiTrackerParams& param
 
 // Births: detections no object explains start tentative objects.
 void add_births(TrackSet& s, const std::vector<Detection>& detections,
-                const std::vector<char>& used, const MultiTrackerParams& params) {
+                const std::vector<char>& used, const std::vector<char>& still,
+                const MultiTrackerParams& params) {
   for (std::size_t j = 0; j < detections.size(); ++j) {
-    if (used[j]) continue;
+    if (used[j] || still[j]) continue;
     const cv::Rect2f& d = detections[j].box;
     bool explained = false;
     for (const Track& t : s.tracks) {
@@ -561,8 +570,11 @@ TrackSet decide(const TrackSet& previous, long long index, cv::Size size,
   const LkMeasures lk = measure_lk(s, motions, params);
   std::vector<char> merged, in_merge;
   find_merges(s, lk.guess, detections, params, merged, in_merge);
+  std::vector<char> still(detections.size(), 0);  // no changed pixels: a ghost
+  for (std::size_t j = 0; j < detections.size(); ++j)
+    still[j] = fg.changed_share(detections[j].box) < params.min_changed ? 1 : 0;
   const std::vector<int> det_of =
-      assign_detections(s, lk.guess, detections, merged, in_merge, params);
+      assign_detections(s, lk.guess, detections, still, merged, in_merge, params);
   std::vector<char> used = merged;  // detections that start no object
   for (int j : det_of)
     if (j >= 0) used[static_cast<std::size_t>(j)] = 1;
@@ -573,7 +585,7 @@ TrackSet decide(const TrackSet& previous, long long index, cv::Size size,
       params.births && ((index % params.global_interval) == 0 || any_lost || s.tracks.empty());
   if (global) {
     ++s.global_activations;
-    add_births(s, detections, used, params);
+    add_births(s, detections, used, still, params);
   }
   if (global_frame != nullptr) *global_frame = global;
   return s;

@@ -23,7 +23,10 @@
 //    paper's Fig. 3 correction), predicted, then corrected by the detection the optimal
 //    assignment (core/assignment.hpp) gives it (cost 1 - IoU with where LK or the prediction puts
 //    it), or, where background-subtraction blobs merge (one blob over several objects) or no
-//    detection is left, by its LK motion as long as its box holds moving pixels. Births: detections
+//    detection is left, by its LK motion as long as its box holds moving pixels. Moving pixels
+//    are the model's foreground where the frame also changed (Foreground::changed): a ghost (the
+//    background uncovered where an object stood when the model learnt it) measures nothing and
+//    starts nothing. Births: detections
 //    no object explains, confirmed after `min_hits` consecutive frames, found on global frames
 //    (every `global_interval` frames and whenever an object is lost). Deaths: lost for
 //    `max_lost` frames, no moving pixels for `still_frames` frames, less than `min_visible` of
@@ -73,6 +76,9 @@ struct MultiTrackerParams {
   double merge_area = 1.1;      // a detection over half of two objects' boxes and this many times
                                 // larger than each is a merge of them (LK follows them), > 0
   double min_moving = 0.08;     // share of moving pixels a box needs to count as moving, [0, 1)
+  double min_changed = 0.02;    // and share of changed pixels (Foreground::changed: a ghost of
+                                // the background model has none), [0, 1); a detection with
+                                // fewer measures no object and starts none
   double gate_iou = 0.1;        // a detection farther from an object (IoU) is not its, [0, 1)
   int min_hits = 3;             // consecutive detections that confirm a birth, >= 1
   int max_lost = 12;            // frames an object coasts without a measurement before it ends

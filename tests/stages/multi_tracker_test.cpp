@@ -101,6 +101,50 @@ TEST(DetectObjects, SplitsNeighboursAtTheValleyBetweenThem) {
   EXPECT_EQ(stages::detect_objects(fg, p).size(), 2u);
 }
 
+TEST(DetectObjects, AHoleInsideAnObjectIsNoValley) {
+  // A vehicle's window the background model misses: its columns hold fewer moving pixels, but
+  // the object spans them top to bottom (a valley of the pixel count, not a gap).
+  stages::Foreground fg;
+  fg.observed = 100;
+  fg.frame_size = {200, 100};
+  fg.mask = cv::Mat::zeros(100, 200, CV_8U);
+  fg.mask(cv::Rect(20, 30, 70, 30)).setTo(255);
+  fg.mask(cv::Rect(60, 35, 12, 20)).setTo(0);  // the hole: 1/3 of its columns' pixels left
+  cv::integral(fg.mask / 255, fg.integral, CV_32S);
+  stages::MotionDetectorParams p;
+  p.work_width = 0;
+  p.split_valley = 0.7;
+  const std::vector<stages::Detection> found = stages::detect_objects(fg, p);
+  std::ostringstream got;
+  for (const auto& d : found)
+    got << " " << d.box;
+  ASSERT_EQ(found.size(), 1u) << got.str();
+  EXPECT_EQ(found[0].box, cv::Rect2f(20, 30, 70, 30));
+}
+
+// Object 0 stands still from the first frame, so that the background model learns it as
+// background; at frame 30 object 1 takes its place and drives away. Where object 0 stood then
+// turns into foreground for a while (a ghost), though nothing changes there.
+MotScene ghost_scene() {
+  return MotScene({240, 160}, {{{20, 60, 24, 40}, {0, 0}, 0, 29}, {{20, 60, 24, 40}, {4, 0}, 30}});
+}
+
+TEST(MotionDetector, TellsAGhostFromAMovingObject) {
+  const MotScene scene = ghost_scene();
+  stages::MotionDetector detector;
+  stages::Foreground fg;
+  const int last = 46;
+  for (int t = 0; t <= last; ++t)
+    fg = detector.observe(scene.frame(t));
+  const cv::Rect2f ghost = scene.box(0, 0), now = scene.box(1, last);
+  ASSERT_EQ((ghost & now).area(), 0.f);
+  EXPECT_GT(fg.moving_share(ghost), 0.3);
+  EXPECT_LT(fg.changed_share(ghost), 0.01);
+  EXPECT_GT(fg.moving_share(now), 0.5);
+  EXPECT_GT(fg.changed_share(now), 0.1);
+  EXPECT_LT(fg.changed_share({150, 10, 40, 40}), 0.01);  // static background
+}
+
 TEST(MotionDetector, RejectsBadParamsAndSizeChanges) {
   stages::MotionDetectorParams p;
   p.min_area = 0;
@@ -227,6 +271,18 @@ TEST(MultiTracker, ObjectThatStopsEndsAndIsNotReportedOnEmptyBackground) {
   const auto found = run(scene, 90, p);
   for (int t = 31 + p.max_lost + 2; t < 90; ++t)
     EXPECT_TRUE(found[static_cast<std::size_t>(t)].empty()) << "frame " << t;
+}
+
+TEST(MultiTracker, StartsNoObjectOnAGhost) {
+  const MotScene scene = ghost_scene();
+  const cv::Rect2f ghost = scene.box(0, 0);
+  const auto found = run(scene, 75);
+  for (int t = 42; t < 75; ++t) {
+    for (const auto& [id, box] : found[static_cast<std::size_t>(t)])
+      EXPECT_LT(test::box_iou(box, ghost), 0.2) << "frame " << t << " object " << id << " " << box;
+  }
+  const std::vector<Coverage> c = coverage(scene, found, 45);
+  EXPECT_GT(c[1].covered, 0.8);  // the object that drives away is found
 }
 
 TEST(MultiTracker, FollowsKnownTargetsWithTheirIds) {
