@@ -210,7 +210,8 @@ void flow_from_pyramids(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkPar
       plan.finest == 0 && params.final_median == 0 && region.size() == comp[0].size();
   for (int l = levels - 1; l >= 0; --l) {
     const cv::Rect& c = comp[l];
-    if (l < plan.finest) {  // below the finest level the flow is only upsampled
+    if (l == 0 && plan.finest > 0) break;  // level 0 is upsampled into the result below
+    if (l < plan.finest) {                 // below the finest level the flow is only upsampled
       upsample_flow(view(ws.u[l + 1], comp[l + 1].size()), comp[l + 1].tl(), c, ws.u[l], &exec);
       upsample_flow(view(ws.v[l + 1], comp[l + 1].size()), comp[l + 1].tl(), c, ws.v[l], &exec);
       continue;
@@ -246,22 +247,29 @@ void flow_from_pyramids(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkPar
   }
 
   const cv::Rect crop(region.tl() - comp[0].tl(), region.size());
-  const cv::Mat u = view(ws.u[0], comp[0].size())(crop), v = view(ws.v[0], comp[0].size())(crop);
   const cv::Mat confidence = view(ws.confidence, comp[plan.finest].size());
-  result.flow.create(crop.size(), CV_32FC2);
   result.confidence.create(crop.size(), CV_32F);
+  if (plan.finest > 0) {
+    // Level 1's flow upsampled straight onto the region, interleaved (each pixel's value depends
+    // only on where it lies, so the region gives level 0's computed rectangle's values there).
+    detail::upsample_flow_pair(view(ws.u[1], comp[1].size()), view(ws.v[1], comp[1].size()),
+                               comp[1].tl(), region, result.flow, &exec);
+    exec.for_range(0, crop.height, 64, [&](int y0, int y1) {
+      confidence_to_level0(confidence, comp[plan.finest], plan.finest, region, result.confidence,
+                           y0, y1);
+    });
+    result.region = region;
+    return;
+  }
+  const cv::Mat u = view(ws.u[0], comp[0].size())(crop), v = view(ws.v[0], comp[0].size())(crop);
+  result.flow.create(crop.size(), CV_32FC2);
   // Row blocks on the executor: at VGA these copies are a few per cent of a pair.
   exec.for_range(0, crop.height, 64, [&](int y0, int y1) {
     const cv::Rect rows(0, y0, crop.width, y1 - y0);
     const cv::Mat planes[] = {u(rows), v(rows)};
     cv::Mat out = result.flow(rows);
     cv::merge(planes, 2, out);
-    if (plan.finest > 0) {
-      confidence_to_level0(confidence, comp[plan.finest], plan.finest, region, result.confidence,
-                           y0, y1);
-    } else {
-      confidence(crop)(rows).copyTo(result.confidence(rows));
-    }
+    confidence(crop)(rows).copyTo(result.confidence(rows));
   });
   result.region = region;
 }

@@ -304,4 +304,28 @@ void upsample_flow(const cv::Mat& src, cv::Point src_origin, const cv::Rect& dst
   }
 }
 
+void upsample_flow_pair(const cv::Mat& src_u, const cv::Mat& src_v, cv::Point src_origin,
+                        const cv::Rect& dst, cv::Mat& flow, const Executor* executor) {
+  flow.create(dst.size(), CV_32FC2);
+  const LkKernels& k = lk_kernels();
+  auto rows = [&](int y0, int y1) {
+    std::vector<float> temp(upsample_temp_floats(std::max(src_u.cols, src_v.cols)));
+    std::vector<float> u(static_cast<std::size_t>(dst.width)), v(u.size());
+    for (int y = y0; y < y1; ++y) {
+      upsample_row(k, src_u, src_origin, dst, y, temp.data(), u.data());
+      upsample_row(k, src_v, src_origin, dst, y, temp.data(), v.data());
+      float* out = flow.ptr<float>(y);
+      for (int x = 0; x < dst.width; ++x) {
+        out[2 * x] = u[x];
+        out[2 * x + 1] = v[x];
+      }
+    }
+  };
+  if (executor && executor->concurrency() > 1) {
+    executor->for_range(0, dst.height, kMinBandRows, rows);
+  } else {
+    rows(0, dst.height);
+  }
+}
+
 }  // namespace roiflow::flow::detail

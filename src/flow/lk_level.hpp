@@ -100,4 +100,10 @@ void iterate_level(const LevelProblem& p, const LevelInput& input, cv::Mat& u, c
 void upsample_flow(const cv::Mat& src, cv::Point src_origin, const cv::Rect& dst, cv::Mat& out,
                    const Executor* executor = nullptr);
 
+// upsample_flow of both components at once, written interleaved into `flow` (CV_32FC2,
+// dst-sized, created here): the values of two upsample_flow calls and a cv::merge, without the
+// two planes between them (the level-0 flow of a region LK ran on coarser levels).
+void upsample_flow_pair(const cv::Mat& src_u, const cv::Mat& src_v, cv::Point src_origin,
+                        const cv::Rect& dst, cv::Mat& flow, const Executor* executor = nullptr);
+
 }  // namespace roiflow::flow::detail
