@@ -499,7 +499,8 @@ bool correct_tracks(TrackSet& s, bool first, const LkMeasures& lk, const std::ve
   return any_lost;
 }
 
-// Duplicates (two objects on one box for 3 frames: the younger ends), deaths and confirmations.
+// Duplicates (two objects on one box, or a fragment inside an older one, for 3 frames: the
+// younger ends), deaths and confirmations.
 void end_and_confirm(TrackSet& s, cv::Size size, const MultiTrackerParams& params) {
   const std::size_t n = s.tracks.size();
   for (std::size_t i = 0; i < n; ++i) {
@@ -508,7 +509,12 @@ void end_and_confirm(TrackSet& s, cv::Size size, const MultiTrackerParams& param
       if (i == j || s.tracks[j].id == 0 || s.tracks[i].id == 0) continue;
       const bool older = s.tracks[j].age > s.tracks[i].age ||
                          (s.tracks[j].age == s.tracks[i].age && s.tracks[j].id < s.tracks[i].id);
-      if (older && iou(s.tracks[i].box, s.tracks[j].box) > 0.7) dup = true;
+      // One box on the other, or a fragment inside one at least twice its size (a slice of
+      // a vehicle the split cut off: it would make that vehicle's detection a merge of two).
+      const cv::Rect2f& a = s.tracks[i].box;
+      const cv::Rect2f& b = s.tracks[j].box;
+      const bool fragment = (a & b).area() >= 0.8 * a.area() && 2 * a.area() < b.area();
+      if (older && (iou(a, b) > 0.7 || fragment)) dup = true;
     }
     s.tracks[i].duplicate = dup ? s.tracks[i].duplicate + 1 : 0;
   }

@@ -31,7 +31,8 @@
 //    (every `global_interval` frames and whenever an object is lost). Deaths: lost for
 //    `max_lost` frames, no moving pixels for `still_frames` frames, less than `min_visible` of
 //    the box inside the frame, or a side under `min_side` pixels; an object that duplicates an
-//    older one for 3 frames ends too.
+//    older one (IoU > 0.7, or 80% of its box inside an older one twice its size: a fragment)
+//    for 3 frames ends too.
 // A box that does not move with moving pixels, collapses or leaves the view is never reported
 // found: it is lost (coasting, `lost`) until it ends.
 #pragma once

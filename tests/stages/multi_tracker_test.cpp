@@ -285,6 +285,38 @@ TEST(MultiTracker, StartsNoObjectOnAGhost) {
   EXPECT_GT(c[1].covered, 0.8);  // the object that drives away is found
 }
 
+TEST(Decide, EndsAFragmentInsideAnOlderObject) {
+  // A slice the blob split once cut off a vehicle, followed as an object of its own inside the
+  // vehicle's box: it ends after 3 frames; an object as small beside the vehicle stays.
+  MultiTrackerParams p;
+  stages::TrackSet s;
+  s.frame = 10;
+  s.size = {320, 240};
+  s.next_id = 4;
+  const cv::Rect2f vehicle(100, 100, 80, 36), slice(150, 102, 16, 32), beside(250, 100, 16, 32);
+  const std::pair<long long, cv::Rect2f> objects[] = {{1, vehicle}, {2, slice}, {3, beside}};
+  for (const auto& [id, box] : objects) {
+    stages::Track t;
+    t.id = id;
+    t.box = box;
+    t.filter = stages::BoxFilter::start(box);
+    t.age = id == 1 ? 30 : 5;
+    s.tracks.push_back(t);
+  }
+  const std::vector<stages::Detection> found = {{vehicle, {140, 118}, vehicle.area()},
+                                                {beside, {258, 116}, beside.area()}};
+  const stages::Foreground none;
+  for (int k = 1; k <= 3; ++k) {
+    s = stages::decide(s, 10 + k, s.size, {}, none, found, p);
+    std::set<long long> ids;
+    for (const stages::Track& t : s.tracks)
+      ids.insert(t.id);
+    EXPECT_EQ(ids.count(1), 1u) << "frame " << k;
+    EXPECT_EQ(ids.count(3), 1u) << "frame " << k;
+    EXPECT_EQ(ids.count(2), k < 3 ? 1u : 0u) << "frame " << k;
+  }
+}
+
 TEST(MultiTracker, FollowsKnownTargetsWithTheirIds) {
   MotScene scene({240, 160}, {{{20, 40, 24, 40}, {2, 0}, 0}, {{180, 90, 24, 40}, {-2, 0}, 0}});
   MultiTrackerParams p;
