@@ -38,9 +38,11 @@ fi
 
 # The arm64 counterparts of scripts/deps.sh's libraries (no benchmark: the benches are not built).
 arm64_packages=libc6-dev,libstdc++-12-dev,libgcc-12-dev,libopencv-dev,libtbb-dev,libcli11-dev
+arm64_packages+=,libfmt-dev,libeigen3-dev
 arm64_packages+=,nlohmann-json3-dev,libavformat-dev,libavcodec-dev,libavutil-dev,libswscale-dev
 arm64_packages+=,libgtest-dev,libgmock-dev
-if [[ ! -f "$sysroot/.roiflow-sysroot" ]]; then
+# The marker holds the package list: a sysroot made for an older list is made again.
+if [[ "$(cat "$sysroot/.roiflow-sysroot" 2>/dev/null)" != "$arm64_packages" ]]; then
   echo "arm64: extracting the arm64 packages into $sysroot (about 1.1 GB)"
   rm -rf "$sysroot"
   mkdir -p "$(dirname "$sysroot")"
@@ -54,7 +56,7 @@ if [[ ! -f "$sysroot/.roiflow-sysroot" ]]; then
       ln -sf "$alternative/$(basename "$library")" "$triplet_dir/$(basename "$library")"
     done
   done
-  touch "$sysroot/.roiflow-sysroot"
+  echo "$arm64_packages" >"$sysroot/.roiflow-sysroot"
 fi
 
 targets=()
