@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "lk_configurations.hpp"
 #include "test_util.hpp"
 
 namespace roiflow::flow {
@@ -30,40 +31,6 @@ cv::Mat texture(cv::Size size, std::uint64_t seed) {
   cv::Mat smooth;
   cv::GaussianBlur(noise, smooth, cv::Size(), 1.5);
   return smooth;
-}
-
-LkParams with_patch(LkParams p, int patch) {
-  p.patch = patch;
-  return p;
-}
-
-LkParams with_derivative(LkParams p, Derivative d) {
-  p.derivative = d;
-  return p;
-}
-
-// paper on 4 levels with 1 iteration at the finest (docs/PERFORMANCE.md, variant l4i1r).
-LkParams paper_l4i1r() {
-  LkParams p = LkParams::paper();
-  p.levels = 4;
-  p.finest_iterations = 1;
-  p.mask_outside = true;
-  p.robust_scale = 0.04;
-  return p;
-}
-
-struct NamedParams {
-  const char* name;
-  LkParams params;
-};
-
-std::vector<NamedParams> configurations() {
-  return {{"paper", LkParams::paper()},
-          {"paper patch 9", with_patch(LkParams::paper(), 9)},
-          {"paper l4i1r", paper_l4i1r()},
-          {"accurate", LkParams::accurate()},
-          {"accurate patch 11 scharr",
-           with_derivative(with_patch(LkParams::accurate(), 11), Derivative::Scharr)}};
 }
 
 TEST(DenseLkTest, RejectsEmptyFrames) {
@@ -174,7 +141,7 @@ TEST(DenseLkTest, TinyImagesGiveFiniteFlowOfTheRightSize) {
     cv::Mat a(size, CV_8UC1), b(size, CV_8UC1);
     rng.fill(a, cv::RNG::UNIFORM, 0, 256);
     rng.fill(b, cv::RNG::UNIFORM, 0, 256);
-    for (const NamedParams& c : configurations()) {
+    for (const test::NamedParams& c : test::lk_configurations()) {
       const FlowResult moved = dense_flow(a, b, c.params);
       ASSERT_EQ(moved.flow.size(), size) << c.name << " " << size;
       ASSERT_EQ(moved.flow.type(), CV_32FC2);

@@ -7,6 +7,7 @@
 
 #include "eval/synthetic.hpp"
 #include "flow/dense_lk.hpp"
+#include "lk_configurations.hpp"
 #include "pipeline/tbb_executor.hpp"
 
 namespace roiflow::flow {
@@ -25,46 +26,12 @@ double max_abs_diff(const cv::Mat& a, const cv::Mat& b) {
   return cv::norm(a, b, cv::NORM_INF);
 }
 
-LkParams with_patch(LkParams p, int patch) {
-  p.patch = patch;
-  return p;
-}
-
-LkParams with_derivative(LkParams p, Derivative d) {
-  p.derivative = d;
-  return p;
-}
-
-// paper on 4 levels with 1 iteration at the finest (docs/PERFORMANCE.md, variant l4i1r).
-LkParams paper_l4i1r() {
-  LkParams p = LkParams::paper();
-  p.levels = 4;
-  p.finest_iterations = 1;
-  p.mask_outside = true;
-  p.robust_scale = 0.04;
-  return p;
-}
-
-struct NamedParams {
-  const char* name;
-  LkParams params;
-};
-
-std::vector<NamedParams> configurations() {
-  return {{"paper", LkParams::paper()},
-          {"paper patch 9", with_patch(LkParams::paper(), 9)},
-          {"paper l4i1r", paper_l4i1r()},
-          {"accurate", LkParams::accurate()},
-          {"accurate patch 11 scharr",
-           with_derivative(with_patch(LkParams::accurate(), 11), Derivative::Scharr)}};
-}
-
 // Bands start on rows where the window sums start afresh and recompute the rows their later
 // iterations read: the split changes nothing, to the last bit.
 TEST(DenseLkTest, TbbBandsGiveTheSerialResultBitForBit) {
   const Scene s = make_scene(SceneKind::Rotation, kSize, 12);
   const pipeline::TbbExecutor tbb_exec;
-  for (const NamedParams& c : configurations()) {
+  for (const test::NamedParams& c : test::lk_configurations()) {
     for (const cv::Rect region : {cv::Rect(), cv::Rect(40, 30, 200, 150)}) {
       FlowOptions options;
       options.region = region;
@@ -86,7 +53,7 @@ TEST(DenseLkTest, TbbBandsGiveTheSerialResultBitForBit) {
 TEST(DenseLkTest, TbbBandsAreDeterministic) {
   const Scene s = make_scene(SceneKind::NonRigid, kSize, 13);
   const pipeline::TbbExecutor tbb_exec;
-  for (const NamedParams& c : configurations()) {
+  for (const test::NamedParams& c : test::lk_configurations()) {
     const auto run = [&] {
       return pipeline::run_with_threads(
           2, [&] { return dense_flow(s.frame0, s.frame1, c.params, {}, &tbb_exec); });
@@ -100,7 +67,7 @@ TEST(DenseLkTest, TbbBandsAreDeterministic) {
 TEST(DenseLkTest, ExecutorIsPartOfTheObjectNotTheOptions) {
   const Scene s = make_scene(SceneKind::MovingObject, kSize, 6);
   const pipeline::TbbExecutor tbb;
-  for (const NamedParams& c : configurations()) {
+  for (const test::NamedParams& c : test::lk_configurations()) {
     const FlowResult serial = DenseLK(c.params).calc(s.frame0, s.frame1);
     DenseLK lk(c.params, &tbb);
     EXPECT_EQ(lk.executor(), &tbb);

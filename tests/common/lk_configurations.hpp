@@ -1,0 +1,51 @@
+// The LK parameter sets the dense LK tests run every property over: the presets, a smaller and
+// a larger patch, Scharr derivatives, and the 4-level `paper` variant of docs/PERFORMANCE.md.
+//
+//   for (const roiflow::test::NamedParams& c : roiflow::test::lk_configurations()) {
+//     SCOPED_TRACE(c.name);
+//     roiflow::flow::DenseLK lk(c.params);
+//   }
+#pragma once
+
+#include <vector>
+
+#include "flow/dense_lk.hpp"
+
+namespace roiflow::test {
+
+inline flow::LkParams with_patch(flow::LkParams p, int patch) {
+  p.patch = patch;
+  return p;
+}
+
+inline flow::LkParams with_derivative(flow::LkParams p, flow::Derivative d) {
+  p.derivative = d;
+  return p;
+}
+
+// paper on 4 levels with 1 iteration at the finest (docs/PERFORMANCE.md, variant l4i1r).
+inline flow::LkParams paper_l4i1r() {
+  flow::LkParams p = flow::LkParams::paper();
+  p.levels = 4;
+  p.finest_iterations = 1;
+  p.mask_outside = true;
+  p.robust_scale = 0.04;
+  return p;
+}
+
+struct NamedParams {
+  const char* name;
+  flow::LkParams params;
+};
+
+inline std::vector<NamedParams> lk_configurations() {
+  using flow::LkParams;
+  return {{"paper", LkParams::paper()},
+          {"paper patch 9", with_patch(LkParams::paper(), 9)},
+          {"paper l4i1r", paper_l4i1r()},
+          {"accurate", LkParams::accurate()},
+          {"accurate patch 11 scharr",
+           with_derivative(with_patch(LkParams::accurate(), 11), flow::Derivative::Scharr)}};
+}
+
+}  // namespace roiflow::test
