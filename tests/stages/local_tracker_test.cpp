@@ -160,13 +160,18 @@ TEST(LocalTracker, LosesAnObjectThatJumpsOutOfItsRegion) {
   EXPECT_GT(center_error(at_jump.box, scene.box(jump)), 40.0);
 }
 
+// Starts `tracker` on the true box of frame 0 and tracks frames [1, last] of `scene`.
+void follow_until(LocalTracker& tracker, const eval::TrackingScene& scene, int last) {
+  tracker.start(frame_of(scene.render(0)), scene.box(0));
+  for (int i = 1; i <= last; ++i)
+    tracker.track(frame_of(scene.render(i)));
+}
+
 TEST(LocalTracker, RestartPlacesTheObjectAgain) {
   const eval::TrackingScene scene(small_scene(60.0, 0.0));
   const int jump = scene.jump_frame();
   LocalTracker tracker;
-  tracker.start(frame_of(scene.render(0)), scene.box(0));
-  for (int i = 1; i < jump; ++i)
-    tracker.track(frame_of(scene.render(i)));
+  follow_until(tracker, scene, jump - 1);
   ASSERT_TRUE(tracker.track(frame_of(scene.render(jump))).lost);
   tracker.restart(frame_of(scene.render(jump)), scene.box(jump));
   EXPECT_EQ(tracker.velocity(), cv::Point2f(0.f, 0.f));
@@ -183,9 +188,7 @@ TEST(LocalTracker, RestartWithTheJumpsVelocityFollowsTheJump) {
   const eval::TrackingScene scene(small_scene(60.0, 0.0));
   const int jump = scene.jump_frame();
   LocalTracker tracker;
-  tracker.start(frame_of(scene.render(0)), scene.box(0));
-  for (int i = 1; i < jump; ++i)
-    tracker.track(frame_of(scene.render(i)));
+  follow_until(tracker, scene, jump - 1);
   const cv::Rect2f before = tracker.box();
   ASSERT_TRUE(tracker.track(frame_of(scene.render(jump))).lost);
   const cv::Point2f shift = (scene.box(jump).tl() - scene.box(jump - 1).tl());
