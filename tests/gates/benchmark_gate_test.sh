@@ -7,22 +7,7 @@
 #   tests/gates/benchmark_gate_test.sh REPO_DIR
 set -uo pipefail
 repo=$1
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-failures=0
-
-expect() {  # expect pass|fail DESCRIPTION COMMAND...
-  local want=$1 what=$2
-  shift 2
-  if "$@" >"$work/out.txt" 2>&1; then got=pass; else got=fail; fi
-  if [[ $got != "$want" ]]; then
-    echo "FAILED: $what: expected $want, got $got"
-    sed 's/^/  | /' "$work/out.txt"
-    failures=$((failures + 1))
-  else
-    echo "ok: $what ($got: $(tail -n 1 "$work/out.txt"))"
-  fi
-}
+source "$(dirname "$0")/expect_lib.sh"
 
 # The stub copies $work/benchmark.csv (when there is one) to --out's folder.
 mkdir -p "$work/stub" "$work/data"
@@ -78,8 +63,4 @@ expect fail "benchmark gate, no header" gate
 rm -f "$work/benchmark.csv"
 expect fail "benchmark gate, no CSV written" gate
 
-if ((failures > 0)); then
-  echo "$failures benchmark gate check(s) failed"
-  exit 1
-fi
-echo "all benchmark gate checks passed"
+report "benchmark gate"

@@ -8,22 +8,7 @@
 set -uo pipefail
 repo=$1
 real_bin=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-failures=0
-
-expect() {  # expect pass|fail DESCRIPTION COMMAND...
-  local want=$1 what=$2
-  shift 2
-  if "$@" >"$work/out.txt" 2>&1; then got=pass; else got=fail; fi
-  if [[ $got != "$want" ]]; then
-    echo "FAILED: $what: expected $want, got $got"
-    sed 's/^/  | /' "$work/out.txt"
-    failures=$((failures + 1))
-  else
-    echo "ok: $what ($got: $(tail -n 1 "$work/out.txt"))"
-  fi
-}
+source "$(dirname "$0")/expect_lib.sh"
 
 # --- eval_gate.sh: a stub whose `eval DIR` prints $work/eval_<folder of DIR>.csv; the cases
 # below spoil middlebury's, the other datasets keep good figures.
@@ -247,8 +232,4 @@ chmod +x "$ci"/scripts/*.sh "$work/ci/bin/ctest"
 expect fail "test.sh, CI=true without ../shared/data" env PATH="$work/ci/bin:$PATH" CI=true "$ci/scripts/test.sh"
 expect pass "test.sh, no CI and no data: a warning" env PATH="$work/ci/bin:$PATH" CI= "$ci/scripts/test.sh"
 
-if ((failures > 0)); then
-  echo "$failures gate check(s) failed"
-  exit 1
-fi
-echo "all gate checks passed"
+report "gate"

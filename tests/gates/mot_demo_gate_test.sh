@@ -8,22 +8,7 @@
 set -uo pipefail
 repo=$1
 real_bin=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-failures=0
-
-expect() {  # expect pass|fail DESCRIPTION COMMAND...
-  local want=$1 what=$2
-  shift 2
-  if "$@" >"$work/out.txt" 2>&1; then got=pass; else got=fail; fi
-  if [[ $got != "$want" ]]; then
-    echo "FAILED: $what: expected $want, got $got"
-    sed 's/^/  | /' "$work/out.txt"
-    failures=$((failures + 1))
-  else
-    echo "ok: $what ($got: $(tail -n 1 "$work/out.txt"))"
-  fi
-}
+source "$(dirname "$0")/expect_lib.sh"
 
 # The stub's demo copies $work/case/* into --dir.
 mkdir -p "$work/stub" "$work/case"
@@ -91,8 +76,4 @@ gt
 : >"$work/case/mot.txt"
 expect fail "mot demo gate, empty mot.txt" gate
 
-if ((failures > 0)); then
-  echo "$failures mot demo gate check(s) failed"
-  exit 1
-fi
-echo "all mot demo gate checks passed"
+report "mot demo gate"
