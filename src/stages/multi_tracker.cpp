@@ -460,6 +460,12 @@ std::vector<int> assign_detections(const TrackSet& s, const std::vector<cv::Rect
   return det_of;
 }
 
+// Whether `box` holds moving pixels: enough foreground, and enough of it changed lately (a
+// ghost of the background model has none).
+bool moves(const Foreground& fg, const cv::Rect2f& box, const MultiTrackerParams& params) {
+  return fg.moving_share(box) >= params.min_moving && fg.changed_share(box) >= params.min_changed;
+}
+
 // Each object's filter corrected by its detection, else by LK where its box holds moving
 // pixels; coasting otherwise. Returns whether a confirmed object is lost.
 bool correct_tracks(TrackSet& s, bool first, const LkMeasures& lk, const std::vector<int>& det_of,
@@ -478,8 +484,7 @@ bool correct_tracks(TrackSet& s, bool first, const LkMeasures& lk, const std::ve
       ++t.hits;
     } else {
       if (t.id == 0) t.hits = -1;  // a tentative object must be seen in consecutive frames
-      if (lk.ok[i] && (t.known || (fg.moving_share(lk.box[i]) >= params.min_moving &&
-                                   fg.changed_share(lk.box[i]) >= params.min_changed))) {
+      if (lk.ok[i] && (t.known || moves(fg, lk.box[i], params))) {
         t.filter.correct_centre((lk.box[i].tl() + lk.box[i].br()) * 0.5f, lk.box[i].height);
         measured = true;
       }
@@ -490,10 +495,7 @@ bool correct_tracks(TrackSet& s, bool first, const LkMeasures& lk, const std::ve
     }
     t.lost = measured ? 0 : t.lost + 1;
     t.box = t.filter.box();
-    t.still = fg.empty() || (fg.moving_share(t.box) >= params.min_moving &&
-                             fg.changed_share(t.box) >= params.min_changed)
-                  ? 0
-                  : t.still + 1;
+    t.still = fg.empty() || moves(fg, t.box, params) ? 0 : t.still + 1;
     if (t.id != 0 && t.lost > 0) any_lost = true;
   }
   return any_lost;
