@@ -48,11 +48,6 @@ inline cv::Rect grown(const cv::Rect& r, int m) {
   return {r.x - m, r.y - m, r.width + 2 * m, r.height + 2 * m};
 }
 
-// The median (the element of rank size / 2); reorders `v`, which must not be empty.
-inline float median(std::vector<float>& v) {
-  return kth_smallest(v.data(), v.size(), v.size() / 2);
-}
-
 // Bilinear sample of a CV_32FC2 field at (x, y), false outside its last full 2x2 cell.
 inline bool sample(const cv::Mat& field, float x, float y, cv::Vec2f& out) {
   if (!(x >= 0.f && y >= 0.f)) return false;

@@ -15,6 +15,7 @@
 #include "core/error.hpp"
 #include "core/text.hpp"
 #include "core/text_file.hpp"
+#include "stages/select_impl.hpp"
 
 namespace roiflow::stages {
 namespace {
@@ -58,10 +59,9 @@ cv::Vec2f sample(const cv::Mat& flow, cv::Point2f p) {
          ay * ((1 - ax) * f.at<cv::Vec2f>(y1, x0) + ax * f.at<cv::Vec2f>(y1, x1));
 }
 
+// The median of a copy of `v` (the caller's values stay as they are).
 float median(std::vector<float> v) {
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
+  return detail::median(v);
 }
 
 }  // namespace
@@ -381,15 +381,15 @@ LkMeasures measure_lk(TrackSet& s, const std::vector<TileMotion>& motions,
     // in front, the pixels of the region follow that one (an object does not turn back at once).
     const cv::Point2f v = t.filter.velocity();
     const double gate = std::max(params.lk_gate, params.lk_gate_share * before.height);
-    const bool agrees =
-        good == 0 || t.age < 3 || std::hypot(median(mx[i]) - v.x, median(my[i]) - v.y) <= gate;
+    const cv::Point2f m = good == 0 ? cv::Point2f() : cv::Point2f(median(mx[i]), median(my[i]));
+    const bool agrees = good == 0 || t.age < 3 || std::hypot(m.x - v.x, m.y - v.y) <= gate;
     if (good >= 4 && static_cast<double>(good) >= params.min_inliers * sampled[i] && agrees) {
       lk.ok[i] = 1;
       cv::Rect2f& b = lk.box[i];
       b.width = lk.guess[i].width;
       b.height = lk.guess[i].height;
-      b.x = before.x + before.width / 2 + median(mx[i]) - lk.guess[i].width / 2;
-      b.y = before.y + before.height / 2 + median(my[i]) - lk.guess[i].height / 2;
+      b.x = before.x + before.width / 2 + m.x - lk.guess[i].width / 2;
+      b.y = before.y + before.height / 2 + m.y - lk.guess[i].height / 2;
       lk.guess[i] = b;
     }
   }

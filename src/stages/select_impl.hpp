@@ -94,4 +94,9 @@ inline float kth_smallest(float* a, std::size_t n, std::size_t k) {
   return kth_smallest(a, n, k, spare.data());
 }
 
+// The median (the element of rank size / 2) of `v`, which must not be empty; overwrites `v`.
+inline float median(std::vector<float>& v) {
+  return kth_smallest(v.data(), v.size(), v.size() / 2);
+}
+
 }  // namespace roiflow::stages::detail

@@ -125,11 +125,7 @@ cv::Rect2f refine_by_motion(const flow::Pyramid& previous, const flow::Pyramid& 
       vs.push_back(f[1]);
     }
   }
-  const auto median = [](std::vector<float>& v) {
-    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-    return v[v.size() / 2];
-  };
-  const float du = median(us), dv = median(vs);
+  const float du = detail::median(us), dv = detail::median(vs);
   const float spread = 0.5f * static_cast<float>(lk.patch) - 1.f;
   const float w = static_cast<float>(stats.at<int>(best, cv::CC_STAT_WIDTH)) - 2.f * spread;
   const float h = static_cast<float>(stats.at<int>(best, cv::CC_STAT_HEIGHT)) - 2.f * spread;
