@@ -11,12 +11,13 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/gate_lib.sh
 bin=${1:-build/release}/roiflow
-# Floors: the values measured when they were set, minus a margin (mot3, MOG2 background ratio
-# 0.5, ghosts measure nothing, fragments end: MOTA 0.627, IDF1 0.745). The issue's bar is
+# Floors: the values measured when they were set, minus a margin (mot4, ghosts absorbed, a blob
+# mostly one object is its detection, sizes in merges stop drifting: MOTA 0.673, IDF1 0.784).
+# The issue's bar is
 # MOTA >= 0.90 and IDF1 >= 0.90: raise the floors towards it as the tracker improves
 # (docs/TRACKING.md).
-min_mota=0.60
-min_idf1=0.72
+min_mota=0.66
+min_idf1=0.77
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 "$bin" demo --objects 16 --dir "$work/demo" --threads 2 --no-progress >/dev/null ||

@@ -26,11 +26,12 @@ namespace roiflow::pipeline {
 
 struct MotionCheckParams {
   // The check's own model of moving pixels: OpenCV's MOG2 background (ratio 0.9, which calls
-  // fewer pixels moving than the tracker's), so that the check does not follow the tracker's
-  // tuning.
+  // fewer pixels moving than the tracker's, and no ghost absorption), so that the check does not
+  // follow the tracker's tuning.
   stages::MotionDetectorParams detector = [] {
     stages::MotionDetectorParams p;
     p.background_ratio = 0.9;
+    p.ghost_frames = 0;  // the model's own foreground: no ghost absorbed
     return p;
   }();
   double still_share = 0.02;  // a box with at most this share of moving pixels has none

@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/background_segm.hpp>
 #include <string>
+#include <vector>
 
 #include "core/error.hpp"
 #include "core/text.hpp"
@@ -31,6 +32,8 @@ void MotionDetectorParams::validate() const {
   if (close_h < 0 || close_h > 64) fail("close_h must be in 0..64, got " + number_text(close_h));
   if (!(join_gap >= 0 && join_gap <= 2))
     fail("join_gap must be in [0, 2], got " + number_text(join_gap));
+  if (ghost_frames < 0 || ghost_frames > 100000)
+    fail("ghost_frames must be in 0..100000, got " + number_text(ghost_frames));
   if (change_frames < 1 || change_frames > 1000)
     fail("change_frames must be in 1..1000, got " + number_text(change_frames));
   if (!(change_level > 0 && change_level < 255))
@@ -73,7 +76,85 @@ struct MotionDetector::Impl {
   cv::Mat small, raw;
   std::vector<cv::Mat> grays;  // the last change_frames + 1 gray frames (model resolution), a ring
   long long observed = 0;
+  // Ghost absorption (model resolution): per pixel, frames in a row it was foreground without
+  // changing; whether it is held as background; the gray level it was absorbed at.
+  cv::Mat quiet, absorbed, absorbed_gray;
 };
+
+namespace {
+
+// Ghost absorption, ViBe-style. Per pixel, `quiet` counts the frames in a row it was
+// foreground without changing (`changed` 0). A connected part of the foreground in which (almost)
+// no pixel changed within the last `frames` frames is a ghost (background uncovered where an
+// object stood when the model learnt it) or an object that stopped: its pixels are taken into
+// the background at once, at their present gray level, and leave `mask`. An absorbed pixel
+// comes back when its gray level moves more than `level` from that value (something new stands
+// there) or the model itself calls it background. A moving object always changes somewhere (its
+// leading and trailing edges), so none of its parts is absorbed, however uniform its body.
+// Returns the count of absorbed pixels.
+long long absorb_ghosts(cv::Mat& mask, const cv::Mat& gray, const cv::Mat& changed, int frames,
+                        double level, cv::Mat& quiet, cv::Mat& absorbed, cv::Mat& absorbed_gray) {
+  if (quiet.size() != mask.size()) {
+    quiet = cv::Mat::zeros(mask.size(), CV_16U);
+    absorbed = cv::Mat::zeros(mask.size(), CV_8U);
+    absorbed_gray = cv::Mat::zeros(mask.size(), CV_8U);
+  }
+  const int limit = static_cast<int>(level);
+  for (int y = 0; y < mask.rows; ++y) {
+    std::uint8_t* m = mask.ptr<std::uint8_t>(y);
+    const std::uint8_t* g = gray.ptr<std::uint8_t>(y);
+    const std::uint8_t* c = changed.ptr<std::uint8_t>(y);
+    std::uint16_t* q = quiet.ptr<std::uint16_t>(y);
+    std::uint8_t* a = absorbed.ptr<std::uint8_t>(y);
+    const std::uint8_t* ag = absorbed_gray.ptr<std::uint8_t>(y);
+    for (int x = 0; x < mask.cols; ++x) {
+      if (a[x] != 0) {
+        if (m[x] != 0 && std::abs(static_cast<int>(g[x]) - ag[x]) <= limit)
+          m[x] = 0;
+        else
+          a[x] = 0;
+      }
+      if (m[x] == 0 || c[x] != 0)
+        q[x] = 0;
+      else if (q[x] < 65535)
+        ++q[x];
+    }
+  }
+  cv::Mat labels, stats, centroids;
+  const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
+  std::vector<int> active(static_cast<std::size_t>(n), 0);
+  for (int y = 0; y < mask.rows; ++y) {
+    const int* l = labels.ptr<int>(y);
+    const std::uint16_t* q = quiet.ptr<std::uint16_t>(y);
+    for (int x = 0; x < mask.cols; ++x)
+      if (l[x] > 0 && q[x] < frames) ++active[static_cast<std::size_t>(l[x])];
+  }
+  std::vector<char> ghost(static_cast<std::size_t>(n), 0);
+  for (int i = 1; i < n; ++i)
+    ghost[static_cast<std::size_t>(i)] =
+        active[static_cast<std::size_t>(i)] <= stats.at<int>(i, cv::CC_STAT_AREA) / 50 ? 1 : 0;
+  long long count = 0;
+  for (int y = 0; y < mask.rows; ++y) {
+    std::uint8_t* m = mask.ptr<std::uint8_t>(y);
+    const int* l = labels.ptr<int>(y);
+    const std::uint8_t* g = gray.ptr<std::uint8_t>(y);
+    std::uint16_t* q = quiet.ptr<std::uint16_t>(y);
+    std::uint8_t* a = absorbed.ptr<std::uint8_t>(y);
+    std::uint8_t* ag = absorbed_gray.ptr<std::uint8_t>(y);
+    for (int x = 0; x < mask.cols; ++x) {
+      if (a[x] != 0) ++count;
+      if (l[x] <= 0 || ghost[static_cast<std::size_t>(l[x])] == 0) continue;
+      a[x] = 1;
+      ag[x] = g[x];
+      q[x] = 0;
+      m[x] = 0;
+      ++count;
+    }
+  }
+  return count;
+}
+
+}  // namespace
 
 MotionDetector::MotionDetector(const MotionDetectorParams& params)
     : params_(params), impl_(std::make_shared<Impl>()) {
@@ -116,13 +197,6 @@ Foreground MotionDetector::observe(const cv::Mat& image) {
   fg.scale = s.scale;
   fg.frame_size = s.frame_size;
   cv::threshold(s.raw, fg.mask, 200, 255, cv::THRESH_BINARY);  // shadows (127) out
-  if (params_.open > 0) {
-    cv::morphologyEx(fg.mask, fg.mask, cv::MORPH_OPEN,
-                     cv::getStructuringElement(cv::MORPH_ELLIPSE, {params_.open, params_.open}));
-  }
-  cv::Mat ones;
-  cv::threshold(fg.mask, ones, 0, 1, cv::THRESH_BINARY);
-  cv::integral(ones, fg.integral, CV_32S);
   // Changed pixels: against the frame change_frames back (a ring of gray frames).
   const std::size_t ring = static_cast<std::size_t>(params_.change_frames) + 1;
   if (s.grays.size() != ring) s.grays.assign(ring, cv::Mat());
@@ -139,8 +213,19 @@ Foreground MotionDetector::observe(const cv::Mat& image) {
     cv::Mat diff;
     cv::absdiff(gray, old, diff);
     cv::threshold(diff, diff, params_.change_level, 1, cv::THRESH_BINARY);
+    if (params_.ghost_frames > 0) {
+      fg.absorbed = absorb_ghosts(fg.mask, gray, diff, params_.ghost_frames, params_.change_level,
+                                  s.quiet, s.absorbed, s.absorbed_gray);
+    }
     cv::integral(diff, fg.changed, CV_32S);
   }
+  if (params_.open > 0) {
+    cv::morphologyEx(fg.mask, fg.mask, cv::MORPH_OPEN,
+                     cv::getStructuringElement(cv::MORPH_ELLIPSE, {params_.open, params_.open}));
+  }
+  cv::Mat ones;
+  cv::threshold(fg.mask, ones, 0, 1, cv::THRESH_BINARY);
+  cv::integral(ones, fg.integral, CV_32S);
   return fg;
 }
 

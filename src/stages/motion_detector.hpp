@@ -11,7 +11,9 @@
 //
 // observe() updates OpenCV's MOG2 with a frame shrunk by the whole factor that brings it nearest
 // `work_width` (shadows are detected and count as background) and returns the frame's
-// foreground mask with its integral image. detect_objects() is the global treatment proper and
+// foreground mask with its integral image; a part of it that has not changed for
+// `ghost_frames` frames (a ghost, or an object that stopped) is absorbed into the background at
+// once, until its gray level changes. detect_objects() is the global treatment proper and
 // keeps no state, so a pipeline runs it beside the next frame's refresh: morphology (an opening
 // removes speckle, a closing joins the parts of one object), connected components, the boxes of
 // those of at least `min_area` full-resolution pixels, and a merge of nested or duplicate boxes
@@ -31,6 +33,9 @@ struct MotionDetectorParams {
   double var_threshold = 16;      // MOG2's squared Mahalanobis distance to call a pixel moving, > 0
   int change_frames = 4;          // Foreground::changed compares with this many frames back, >= 1
   double change_level = 25;       // gray levels (model resolution) a changed pixel differs by, > 0
+  int ghost_frames = 8;           // a foreground pixel that has not changed for this many frames
+                                  // in a row is a ghost (or a stopped object) and is absorbed into
+                                  // the background at once, until its gray level changes; 0 = never
   double background_ratio = 0.5;  // MOG2's background: its heaviest modes that together hold this
                                   // share of the recent frames, (0, 1]. OpenCV's 0.9 takes for
                                   // background any colour seen 10% of the time: the body of a
@@ -71,6 +76,7 @@ struct Foreground {
   // The model's foreground also holds ghosts: background that an object uncovered after
   // standing in it (or since the first frame); a ghost does not change.
   cv::Mat changed;
+  long long absorbed = 0;  // pixels (model resolution) held as absorbed ghosts in this frame
 
   // Share of moving pixels inside `box` (full-resolution pixels, clipped to the frame); 0 for
   // an empty or outside box.

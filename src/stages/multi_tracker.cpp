@@ -128,6 +128,10 @@ void MultiTrackerParams::validate() const {
     fail("min_moving must be in [0, 1), got " + number_text(min_moving));
   if (!(min_changed >= 0 && min_changed < 1))
     fail("min_changed must be in [0, 1), got " + number_text(min_changed));
+  if (!(merge_own > 0 && merge_own <= 1))
+    fail("merge_own must be in (0, 1], got " + number_text(merge_own));
+  if (!(lk_size_decay >= 0 && lk_size_decay <= 1))
+    fail("lk_size_decay must be in [0, 1], got " + number_text(lk_size_decay));
   if (!(gate_iou >= 0 && gate_iou < 1))
     fail("gate_iou must be in [0, 1), got " + number_text(gate_iou));
   if (min_hits < 1) fail("min_hits must be >= 1, got " + number_text(min_hits));
@@ -413,7 +417,13 @@ void find_merges(const TrackSet& s, const std::vector<cv::Rect2f>& guess,
           d.area() >= params.merge_area * guess[i].area())
         inside.push_back(i);
     }
-    if (inside.size() >= 2) {
+    // One of them that is most of the blob (IoU >= merge_own) is its object: the others pass in
+    // front of or behind it, or are slices of it (cut off while it left its ghost). It takes the
+    // detection; the others follow LK.
+    bool owned = false;
+    for (std::size_t i : inside)
+      if (iou(guess[i], d) >= params.merge_own) owned = true;
+    if (inside.size() >= 2 && !owned) {
       merged[j] = 1;
       for (std::size_t i : inside)
         in_merge[i] = 1;
@@ -469,8 +479,8 @@ bool moves(const Foreground& fg, const cv::Rect2f& box, const MultiTrackerParams
 // Each object's filter corrected by its detection, else by LK where its box holds moving
 // pixels; coasting otherwise. Returns whether a confirmed object is lost.
 bool correct_tracks(TrackSet& s, bool first, const LkMeasures& lk, const std::vector<int>& det_of,
-                    const Foreground& fg, const std::vector<Detection>& detections,
-                    const MultiTrackerParams& params) {
+                    const std::vector<char>& in_merge, const Foreground& fg,
+                    const std::vector<Detection>& detections, const MultiTrackerParams& params) {
   bool any_lost = false;
   for (std::size_t i = 0; i < s.tracks.size(); ++i) {
     Track& t = s.tracks[i];
@@ -492,6 +502,12 @@ bool correct_tracks(TrackSet& s, bool first, const LkMeasures& lk, const std::ve
     if (!measured) {
       // Coasting: keep the motion, not a size that grows or shrinks with nothing to see.
       t.filter.x[6] = t.filter.x[7] = 0;
+    } else if (in_merge[i] != 0) {
+      // In a merge LK alone measures the centre, not the size: the size's speed fades (the
+      // blob of several objects no longer feeds it; a vehicle that entered the frame has
+      // stopped growing).
+      t.filter.x[6] *= params.lk_size_decay;
+      t.filter.x[7] *= params.lk_size_decay;
     }
     t.lost = measured ? 0 : t.lost + 1;
     t.box = t.filter.box();
@@ -586,7 +602,8 @@ TrackSet decide(const TrackSet& previous, long long index, cv::Size size,
   std::vector<char> used = merged;  // detections that start no object
   for (int j : det_of)
     if (j >= 0) used[static_cast<std::size_t>(j)] = 1;
-  const bool any_lost = correct_tracks(s, previous.frame < 0, lk, det_of, fg, detections, params);
+  const bool any_lost =
+      correct_tracks(s, previous.frame < 0, lk, det_of, in_merge, fg, detections, params);
   end_and_confirm(s, size, params);
   // Births on global frames: detections no object explains.
   const bool global =

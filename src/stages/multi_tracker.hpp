@@ -76,6 +76,10 @@ struct MultiTrackerParams {
   double lk_gate_share = 0.05;  // predicted one, or this share of the object's height, > 0
   double merge_area = 1.1;      // a detection over half of two objects' boxes and this many times
                                 // larger than each is a merge of them (LK follows them), > 0
+  double merge_own = 0.7;       // but not when one of them overlaps it this much (IoU): that one
+                                // takes it, (0, 1]
+  double lk_size_decay = 0.9;   // per frame an object follows LK alone, its size's speed is
+                                // multiplied by this, [0, 1]
   double min_moving = 0.08;     // share of moving pixels a box needs to count as moving, [0, 1)
   double min_changed = 0.02;    // and share of changed pixels (Foreground::changed: a ghost of
                                 // the background model has none), [0, 1); a detection with

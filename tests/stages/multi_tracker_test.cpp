@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
 #include <opencv2/imgproc.hpp>
 #include <set>
@@ -131,7 +132,9 @@ MotScene ghost_scene() {
 
 TEST(MotionDetector, TellsAGhostFromAMovingObject) {
   const MotScene scene = ghost_scene();
-  stages::MotionDetector detector;
+  stages::MotionDetectorParams p;
+  p.ghost_frames = 0;  // the model's own foreground, ghost and all
+  stages::MotionDetector detector(p);
   stages::Foreground fg;
   const int last = 46;
   for (int t = 0; t <= last; ++t)
@@ -143,6 +146,36 @@ TEST(MotionDetector, TellsAGhostFromAMovingObject) {
   EXPECT_GT(fg.moving_share(now), 0.5);
   EXPECT_GT(fg.changed_share(now), 0.1);
   EXPECT_LT(fg.changed_share({150, 10, 40, 40}), 0.01);  // static background
+  EXPECT_EQ(fg.absorbed, 0);
+}
+
+TEST(MotionDetector, AbsorbsAGhostIntoTheBackgroundAtOnce) {
+  // The same scene with ghost absorption (the default): once the object has left the place it
+  // stood in while the model learnt it, that place (unchanged for ghost_frames frames) is
+  // background again, long before the model would learn it; the object that drives away stays
+  // foreground, every frame.
+  const MotScene scene = ghost_scene();
+  stages::MotionDetectorParams p;
+  ASSERT_GT(p.ghost_frames, 0);
+  stages::MotionDetector detector(p);
+  stages::Foreground fg;
+  const cv::Rect2f ghost = scene.box(0, 0);
+  const int left = 30;  // the object that stood there is gone, the other drives on
+  const int last = left + p.change_frames + p.ghost_frames + 2;
+  for (int t = 0; t <= last; ++t) {
+    fg = detector.observe(scene.frame(t));
+    if (t >= left + 2) {
+      EXPECT_GT(fg.moving_share(scene.box(1, t)), 0.5) << "frame " << t;
+    }
+  }
+  EXPECT_GT(fg.absorbed, 0);
+  EXPECT_LT(fg.moving_share(ghost), 0.05);
+  // Something new standing there later is foreground again: a pixel is absorbed at its gray
+  // level and comes back when that changes.
+  cv::Mat frame = scene.frame(last + 1);
+  cv::rectangle(frame, cv::Rect(ghost), cv::Scalar(255, 255, 255), cv::FILLED);
+  fg = detector.observe(frame);
+  EXPECT_GT(fg.moving_share(ghost), 0.5);
 }
 
 TEST(MotionDetector, RejectsBadParamsAndSizeChanges) {
@@ -317,6 +350,82 @@ TEST(Decide, EndsAFragmentInsideAnOlderObject) {
   }
 }
 
+// A track set of confirmed objects `boxes` (ids 1, 2, ...), decided up to frame 10.
+stages::TrackSet tracks_of(const std::vector<cv::Rect2f>& boxes) {
+  stages::TrackSet s;
+  s.frame = 10;
+  s.size = {320, 240};
+  s.next_id = static_cast<long long>(boxes.size()) + 1;
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    stages::Track t;
+    t.id = static_cast<long long>(i) + 1;
+    t.box = boxes[i];
+    t.filter = stages::BoxFilter::start(boxes[i]);
+    t.age = 10;
+    s.tracks.push_back(t);
+  }
+  return s;
+}
+
+TEST(Decide, ABlobMostlyOneObjectIsItsDetection) {
+  // A blob over two objects is a merge (LK alone moves them), unless one of them is most of it
+  // (IoU >= merge_own): a slice or a small object passing in front of a vehicle. That one takes
+  // the detection and its box follows it.
+  MultiTrackerParams p;
+  const cv::Rect2f vehicle(100, 100, 70, 36), slice(172, 104, 12, 28);
+  const cv::Rect2f blob(104, 100, 82, 36);  // the vehicle 4 px on, with the slice
+  ASSERT_GE(test::box_iou(vehicle, blob), p.merge_own);
+  const stages::Foreground none;
+  stages::TrackSet s = tracks_of({vehicle, slice});
+  s = stages::decide(s, 11, s.size, {}, none, {{blob, {145, 118}, blob.area()}}, p);
+  ASSERT_EQ(s.tracks.size(), 2u);
+  EXPECT_GT(s.tracks[0].box.x, vehicle.x + 2);  // corrected by the blob
+  EXPECT_GT(s.tracks[0].box.width, vehicle.width + 2);
+  EXPECT_EQ(s.tracks[0].lost, 0);
+  EXPECT_GT(s.tracks[1].lost, 0);  // the slice got nothing
+  // Two objects of a size side by side in one blob: a merge, the blob corrects neither.
+  const cv::Rect2f left(100, 100, 40, 36), right(142, 100, 40, 36), both(100, 100, 82, 36);
+  ASSERT_LT(test::box_iou(left, both), p.merge_own);
+  s = stages::decide(tracks_of({left, right}), 11, {320, 240}, {}, none,
+                     {{both, {141, 118}, both.area()}}, p);
+  ASSERT_EQ(s.tracks.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_GT(s.tracks[i].lost, 0) << i;
+    EXPECT_NEAR(s.tracks[i].box.width, 40, 0.5) << i;
+  }
+}
+
+TEST(Decide, InAMergeTheSizeSpeedFades) {
+  // An object whose box was growing (entering the frame), then in a merge (one blob over it and
+  // its neighbour): LK alone measures it, which gives no size, so the size's speed fades by
+  // lk_size_decay a frame instead of growing the box on and on.
+  MultiTrackerParams p;
+  stages::Foreground fg;
+  fg.scale = 1;
+  fg.frame_size = {320, 240};
+  fg.mask = cv::Mat(240, 320, CV_8U, cv::Scalar(255));
+  cv::Mat ones(240, 320, CV_8U, cv::Scalar(1));
+  cv::integral(ones, fg.integral, CV_32S);
+  const cv::Rect2f left(100, 100, 40, 36), right(142, 100, 40, 36), both(100, 100, 82, 36);
+  stages::TrackSet s = tracks_of({left, right});
+  s.tracks[0].filter.x[6] = 2;  // width growing 2 px a frame
+  std::vector<stages::TileMotion> m(2);
+  for (std::size_t i = 0; i < 2; ++i) {
+    m[i].track = i;
+    m[i].sampled = 40;
+    m[i].moves.assign(40, cv::Point2f(0, 0));
+  }
+  const std::vector<stages::Detection> blob = {{both, {141, 118}, both.area()}};
+  for (int k = 1; k <= 20; ++k) {
+    s = stages::decide(s, 10 + k, s.size, m, fg, blob, p);
+    ASSERT_EQ(s.tracks.size(), 2u);
+    EXPECT_EQ(s.tracks[0].lost, 0) << k;  // measured by LK
+    EXPECT_NEAR(s.tracks[0].filter.x[6], 2 * std::pow(p.lk_size_decay, k), 1e-6) << k;
+  }
+  // The sum of a fading speed: 2 * 0.9 / (1 - 0.9) = 18 px at most, not 2 px a frame for ever.
+  EXPECT_LT(s.tracks[0].box.width, 40 + 2 / (1 - p.lk_size_decay) + 1);
+}
+
 TEST(MultiTracker, FollowsKnownTargetsWithTheirIds) {
   MotScene scene({240, 160}, {{{20, 40, 24, 40}, {2, 0}, 0}, {{180, 90, 24, 40}, {-2, 0}, 0}});
   MultiTrackerParams p;
@@ -355,6 +464,15 @@ TEST(MultiTrackerParams, RejectsBadValues) {
   MultiTrackerParams p;
   p.min_side = 0;
   EXPECT_NE(test::error_message([&] { p.validate(); }).find("min_side"), std::string::npos);
+  p = {};
+  p.merge_own = 0;
+  EXPECT_NE(test::error_message([&] { p.validate(); }).find("merge_own"), std::string::npos);
+  p = {};
+  p.lk_size_decay = 1.5;
+  EXPECT_NE(test::error_message([&] { p.validate(); }).find("lk_size_decay"), std::string::npos);
+  p = {};
+  p.detector.ghost_frames = -1;
+  EXPECT_NE(test::error_message([&] { p.validate(); }).find("ghost_frames"), std::string::npos);
   p = {};
   p.known = {{1, {0, 0, 10, 10}}, {1, {5, 5, 10, 10}}};
   EXPECT_NE(test::error_message([&] { p.validate(); }).find("twice"), std::string::npos);
