@@ -240,7 +240,8 @@ bool seeds_level(const LkParams& params, int level, int levels, const FlowOption
 }
 
 void seed_level(const LkParams& params, const cv::Mat& i0, const cv::Mat& i1, const cv::Rect& c,
-                int level, int levels, const FlowOptions& options, cv::Mat& u, cv::Mat& v) {
+                int level, int levels, const FlowOptions& options, cv::Mat& u, cv::Mat& v,
+                const Executor* executor, std::vector<float>* scratch) {
   // A region works on its own rectangle, read as if the frame ended there.
   const cv::Mat a = i0(c), b = i1(c);
   if (level == levels - 1 && params.search_radius > 0 && options.initial_flow.empty()) {
@@ -252,9 +253,9 @@ void seed_level(const LkParams& params, const cv::Mat& i0, const cv::Mat& i1, co
   }
   // Far candidates first: they carry a motion over a distance the near ones then refine.
   if (params.fuse_far_step > 0 && level >= params.fuse_far_finest_level)
-    fuse_candidates(a, b, params.fuse_far_step, kFuseWindow, u, v);
+    fuse_candidates(a, b, params.fuse_far_step, kFuseWindow, u, v, executor, scratch);
   if (params.fuse_step > 0 && level >= params.fuse_finest_level)
-    fuse_candidates(a, b, params.fuse_step, kFuseWindow, u, v);
+    fuse_candidates(a, b, params.fuse_step, kFuseWindow, u, v, executor, scratch);
 }
 
 }  // namespace detail
