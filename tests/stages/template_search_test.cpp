@@ -135,5 +135,27 @@ TEST(TemplateSearch, DirectNccEqualsOpenCvsMatchTemplate) {
             std::string::npos);
 }
 
+// The tracker's searches: a few positions per row (groups of four span rows) and image heights
+// that are not whole groups of the integral images' four rows.
+TEST(TemplateSearch, DirectNccOnSmallWindowsEqualsOpenCvs) {
+  cv::RNG rng(11);
+  for (const cv::Size positions :
+       {cv::Size(6, 6), cv::Size(5, 7), cv::Size(1, 3), cv::Size(9, 2)}) {
+    for (const cv::Size templ_size : {cv::Size(39, 23), cv::Size(8, 5), cv::Size(17, 30)}) {
+      cv::Mat image(templ_size.height + positions.height - 1,
+                    templ_size.width + positions.width - 1, CV_32F);
+      cv::Mat templ(templ_size, CV_32F);
+      rng.fill(image, cv::RNG::UNIFORM, 0.f, 1.f);
+      rng.fill(templ, cv::RNG::UNIFORM, 0.f, 1.f);
+      cv::Mat direct, reference;
+      ccoeff_normed_direct(image, templ, direct);
+      cv::matchTemplate(image, templ, reference, cv::TM_CCOEFF_NORMED);
+      ASSERT_EQ(direct.size(), positions);
+      EXPECT_LT(cv::norm(direct, reference, cv::NORM_INF), 1e-4)
+          << positions << " positions, template " << templ_size;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace roiflow::stages
