@@ -92,15 +92,46 @@ namespace {
 // a few-kilobyte image, and allocating them afresh each time cost more than the sums (glibc
 // returns the freed top of the heap to the system and faults it back in on the next call).
 struct DirectScratch {
-  std::vector<float> templ, image;  // centred, zero-padded rows
-  std::vector<double> sum, sqsum;   // integral images of the centred image, (rows+1) x (cols+1)
+  std::vector<float> image;        // centred, zero-padded rows
+  std::vector<double> sum, sqsum;  // integral images of the centred image, (rows+1) x (cols+1)
 };
 
 }  // namespace
 
+DirectTemplate::DirectTemplate(const cv::Mat& t) : templ(t) {
+  if (t.type() != CV_32FC1 || t.empty()) {
+    throw Error("template search: direct NCC needs a float template");
+  }
+  const int tw = t.cols, th = t.rows;
+  // Centred on its mean: NCC does not change, and the float sums lose far less to rounding
+  // than they would on raw intensities. Rows padded with zeros to whole vectors: each position's
+  // dot product is then whole-vector multiply-adds, reduced once per position.
+  stride = (tw + kLanes - 1) / kLanes * kLanes;
+  rows.resize(static_cast<std::size_t>(th) * stride);
+  const auto t_mean = static_cast<float>(cv::mean(t)[0]);
+  for (int y = 0; y < th; ++y) {
+    const float* src = t.ptr<float>(y);
+    float* dst = rows.data() + static_cast<std::size_t>(y) * stride;
+    float acc = 0.f;
+    for (int x = 0; x < tw; ++x) {
+      dst[x] = src[x] - t_mean;
+      acc += dst[x] * dst[x];
+    }
+    std::fill(dst + tw, dst + stride, 0.f);
+    norm2 += acc;
+  }
+}
+
 void ccoeff_normed_direct(const cv::Mat& image, const cv::Mat& templ, cv::Mat& response) {
-  if (image.type() != CV_32FC1 || templ.type() != CV_32FC1 || templ.cols > image.cols ||
-      templ.rows > image.rows || templ.empty()) {
+  if (templ.type() != CV_32FC1 || templ.empty()) {
+    throw Error("template search: direct NCC needs a float template no larger than the image");
+  }
+  ccoeff_normed_direct(image, DirectTemplate(templ), response);
+}
+
+void ccoeff_normed_direct(const cv::Mat& image, const DirectTemplate& prepared, cv::Mat& response) {
+  const cv::Mat& templ = prepared.templ;
+  if (image.type() != CV_32FC1 || templ.cols > image.cols || templ.rows > image.rows) {
     throw Error("template search: direct NCC needs a float template no larger than the image");
   }
   thread_local DirectScratch scratch;
@@ -108,32 +139,17 @@ void ccoeff_normed_direct(const cv::Mat& image, const cv::Mat& templ, cv::Mat& r
   const int iw = image.cols, ih = image.rows;
   const int nx = iw - tw + 1, ny = ih - th + 1;
   const double n = static_cast<double>(tw) * th;
-  // Both centred on their means: NCC does not change, and the float sums below lose far less
-  // to rounding than they would on raw intensities. Template rows padded with zeros to whole
-  // vectors, image rows with zeros past the end: each position's dot product is then
-  // whole-vector multiply-adds, reduced once per position.
-  const int twp = (tw + kLanes - 1) / kLanes * kLanes;
+  // The image centred on its mean like the template (DirectTemplate), its rows padded with
+  // zeros past the end.
+  const int twp = prepared.stride;
   const int ipw = iw + twp + 4;
   // Only what is read is written: zeroing whole buffers on every call cost as much as the sums
   // (the padding is zeroed row by row below; an integral image's first row and column here).
-  scratch.templ.resize(static_cast<std::size_t>(th) * twp);
   scratch.image.resize(static_cast<std::size_t>(ih) * ipw);
-  const cv::Mat tp(th, twp, CV_32F, scratch.templ.data());
+  const cv::Mat tp(th, twp, CV_32F, const_cast<float*>(prepared.rows.data()));
   const cv::Mat ip(ih, ipw, CV_32F, scratch.image.data());
-  const auto t_mean = static_cast<float>(cv::mean(templ)[0]);
   const auto i_mean = static_cast<float>(cv::mean(image)[0]);
-  double t_norm2 = 0;
-  for (int y = 0; y < th; ++y) {
-    const float* src = templ.ptr<float>(y);
-    float* dst = scratch.templ.data() + static_cast<std::size_t>(y) * twp;
-    float acc = 0.f;
-    for (int x = 0; x < tw; ++x) {
-      dst[x] = src[x] - t_mean;
-      acc += dst[x] * dst[x];
-    }
-    std::fill(dst + tw, dst + twp, 0.f);
-    t_norm2 += acc;
-  }
+  const double t_norm2 = prepared.norm2;
   const std::size_t sw = static_cast<std::size_t>(iw) + 1;
   scratch.sum.resize(sw * (ih + 1));
   scratch.sqsum.resize(sw * (ih + 1));
@@ -251,16 +267,21 @@ bool prior_on(const MatchPrior& p) {
   return p.radius > 0 && p.penalty > 0;
 }
 
-// Best full-resolution match of `templ` (already scaled) in `region` of `image`.
+// Best full-resolution match of `templ` (already scaled; `prepared` when the caller has it) in
+// `region` of `image`.
 TemplateMatch match_one(const cv::Mat& image, const cv::Mat& templ, const cv::Rect& region,
-                        const MatchPrior& prior = {}) {
+                        const MatchPrior& prior = {}, const DirectTemplate* prepared = nullptr) {
   TemplateMatch best;
   if (region.width < templ.cols || region.height < templ.rows) return best;
   thread_local cv::Mat response;  // reused: see DirectScratch
   const double work = static_cast<double>(region.width - templ.cols + 1) *
                       (region.height - templ.rows + 1) * templ.total();
   if (image.depth() == CV_32F && work <= kDirectLimit) {
-    ccoeff_normed_direct(image(region), templ, response);
+    if (prepared != nullptr) {
+      ccoeff_normed_direct(image(region), *prepared, response);
+    } else {
+      ccoeff_normed_direct(image(region), templ, response);
+    }
   } else {
     cv::matchTemplate(image(region), templ, response, cv::TM_CCOEFF_NORMED);
   }
@@ -311,6 +332,22 @@ TemplateMatch match_one(const cv::Mat& image, const cv::Mat& templ, const cv::Re
 }
 
 }  // namespace
+
+TemplateMatch match_template(const cv::Mat& image, const DirectTemplate& templ,
+                             const cv::Rect& search, const MatchPrior& prior) {
+  if (image.empty()) throw Error("template search: empty image or template");
+  if (image.type() != CV_32FC1) {
+    throw Error("template search: a prepared template needs a float image, got " +
+                cv::typeToString(image.type()));
+  }
+  if (!(prior.radius >= 0 && prior.penalty >= 0)) {
+    throw Error("template search: the prior's radius and penalty must be >= 0");
+  }
+  const cv::Rect region = search & cv::Rect(0, 0, image.cols, image.rows);
+  if (region.empty()) return {};
+  const TemplateMatch m = match_one(image, templ.templ, region, prior, &templ);
+  return m.score > -1 ? m : TemplateMatch{};
+}
 
 TemplateMatch match_template(const cv::Mat& image, const cv::Mat& templ, const cv::Rect& search,
                              const TemplateSearchParams& params, const MatchPrior& prior) {

@@ -157,5 +157,26 @@ TEST(TemplateSearch, DirectNccOnSmallWindowsEqualsOpenCvs) {
   }
 }
 
+// A template prepared once matches as the template itself does, prior and all.
+TEST(TemplateSearch, APreparedTemplateMatchesAsTheTemplate) {
+  cv::Mat image, patch;
+  texture({160, 120}, 5).convertTo(image, CV_32F, 1.0 / 255);
+  image(cv::Rect(70, 40, 33, 21)).copyTo(patch);
+  const DirectTemplate prepared(patch);
+  for (const MatchPrior prior : {MatchPrior{}, MatchPrior{{60.f, 50.f}, 20, 0.2}}) {
+    for (const cv::Rect search : {cv::Rect(60, 30, 50, 40), cv::Rect(66, 37, 40, 27),
+                                  cv::Rect(150, 100, 40, 40), cv::Rect(0, 0, 20, 20)}) {
+      const TemplateMatch a = match_template(image, patch, search, {{1.0}, 0}, prior);
+      const TemplateMatch b = match_template(image, prepared, search, prior);
+      EXPECT_EQ(a.score, b.score) << search;
+      EXPECT_EQ(a.ranked, b.ranked) << search;
+      EXPECT_EQ(a.box, b.box) << search;
+    }
+  }
+  EXPECT_GT(match_template(image, prepared, cv::Rect(60, 30, 50, 40)).score, 0.99);
+  EXPECT_NE(error_message([&] { DirectTemplate{cv::Mat(3, 3, CV_8U)}; }).find("float"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace roiflow::stages
