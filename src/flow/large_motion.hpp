@@ -50,10 +50,13 @@ struct SearchParams {
 
 // Coarse search of `i0`'s pixels in `i1` (same size as i0, u and v) around `prior` (level
 // pixels): u, v become each pixel's reliable integer displacement, or its fill (see above).
-// Frame borders are replicated. Throws roiflow::Error on mismatched inputs or parameters out
-// of range (radius 1..kMaxSearchRadius, window odd 3..15, tolerance >= 0, margin in [0, 1)).
+// Frame borders are replicated. With an executor of two threads or more, parts of the
+// displacements are searched side by side, with the same result. Throws roiflow::Error on
+// mismatched inputs or parameters out of range (radius 1..kMaxSearchRadius, window odd 3..15,
+// tolerance >= 0, margin in [0, 1)).
 void search_flow(const cv::Mat& i0, const cv::Mat& i1, cv::Point2f prior,
-                 const SearchParams& params, cv::Mat& u, cv::Mat& v);
+                 const SearchParams& params, cv::Mat& u, cv::Mat& v,
+                 const Executor* executor = nullptr);
 
 // Candidate fusion: each pixel keeps its own flow or takes that of the pixel `step` away in
 // one of the 8 directions, whichever has the smallest zero-mean SSD over a `window` x `window`

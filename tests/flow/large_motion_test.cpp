@@ -196,6 +196,24 @@ TEST(CandidateFusionTest, ThreadedScheduleGivesTheSerialResultBitForBit) {
   }
 }
 
+TEST(CoarseSearchTest, ThreadedScheduleGivesTheSerialResultBitForBit) {
+  const cv::Mat i0 = texture({71, 53}, 11);
+  const cv::Mat i1 = moved(i0, {6.f, -4.f});
+  for (const int radius : {3, 8}) {
+    SearchParams params;
+    params.radius = radius;
+    cv::Mat u(i0.size(), CV_32F, 0.f), v(i0.size(), CV_32F, 0.f);
+    search_flow(i0, i1, {0.5f, 0.f}, params, u, v);
+    cv::Mat tu(i0.size(), CV_32F, 0.f), tv(i0.size(), CV_32F, 0.f);
+    const ReversedChunks two;
+    search_flow(i0, i1, {0.5f, 0.f}, params, tu, tv, &two);
+    EXPECT_GT(two.calls, 2) << "radius " << radius;
+    EXPECT_GT(cv::countNonZero(u != 0.f), 0) << "radius " << radius;
+    EXPECT_EQ(cv::norm(u, tu, cv::NORM_INF), 0.0) << "radius " << radius;
+    EXPECT_EQ(cv::norm(v, tv, cv::NORM_INF), 0.0) << "radius " << radius;
+  }
+}
+
 TEST(CandidateFusionTest, FlatFramesKeepEveryPixelsOwnFlow) {
   // Every candidate ties on flat frames: each pixel keeps its own flow, bit for bit.
   const cv::Mat flat(30, 40, CV_32F, cv::Scalar(0.25));
