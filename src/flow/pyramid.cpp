@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <opencv2/imgproc.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/error.hpp"
@@ -60,14 +61,29 @@ void smooth_to_unit_float(const cv::Mat& image, const float* k, int R, cv::Mat& 
   const detail::LkKernels& kernels = detail::lk_kernels();
   const int taps = 2 * R + 1;
   const int w = image.cols, h = image.rows;
-  std::vector<float> padded(static_cast<std::size_t>(w + 2 * R));
-  std::vector<float> ring(static_cast<std::size_t>(taps) * w);
+  // Kept per thread: a tracker builds a few small parts every frame.
+  thread_local std::vector<float> padded, ring;
+  padded.resize(static_cast<std::size_t>(w + 2 * R));
+  ring.resize(static_cast<std::size_t>(taps) * w);
   auto filtered = [&](int row) { return ring.data() + static_cast<std::size_t>(row % taps) * w; };
   const float* rows[9];
   out.create(h, w, CV_32F);
-  int next = 0;  // rows [0, next) are filtered (the ring holds the last `taps` of them)
+  // A part of a frame is a few hundred bytes of each of its rows, often not in the cache (a
+  // frame just decoded on another core, or one of many in memory): asking for the rows a few
+  // ahead of the one filtered keeps the loads from waiting on memory one row at a time. (Inline:
+  // GCC takes a function that only prefetches for a pure one and drops its calls.)
+  constexpr int kAhead = 8;
+  const std::size_t row_bytes = static_cast<std::size_t>(w) * image.elemSize();
+  int fetched = 0;  // rows [0, fetched) have been asked for
+  int next = 0;     // rows [0, next) are filtered (the ring holds the last `taps` of them)
   for (int y = 0; y < h; ++y) {
     for (; next <= std::min(h - 1, y + R); ++next) {
+      for (; fetched < std::min(h, next + kAhead); ++fetched) {
+        const std::uint8_t* row = image.ptr<std::uint8_t>(fetched);
+        for (std::size_t i = 0; i < row_bytes; i += 64)
+          __builtin_prefetch(row + i);
+        __builtin_prefetch(row + row_bytes - 1);
+      }
       float* p = padded.data();
       unit_row(kernels, image, next, p + R);
       std::fill(p, p + R, p[R]);
@@ -103,8 +119,12 @@ void base_level(const cv::Mat& image, double sigma, cv::Mat& out) {
   }
   const int ksize = sigma > 0.0 ? std::max(3, cvRound(sigma * 8 + 1) | 1) : 0;
   if (ksize > 0 && ksize / 2 <= 4) {
-    const cv::Mat kernel = cv::getGaussianKernel(ksize, sigma, CV_32F);
-    return smooth_to_unit_float(gray, kernel.ptr<float>(), ksize / 2, out);
+    // The kernel of the last sigma, kept per thread (OpenCV computes it in soft floating point).
+    thread_local std::pair<double, cv::Mat> kernel;
+    if (kernel.second.empty() || kernel.first != sigma) {
+      kernel = {sigma, cv::getGaussianKernel(ksize, sigma, CV_32F)};
+    }
+    return smooth_to_unit_float(gray, kernel.second.ptr<float>(), ksize / 2, out);
   }
   out.create(gray.size(), CV_32F);
   const detail::LkKernels& kernels = detail::lk_kernels();

@@ -138,21 +138,22 @@ inline int coarsest_level_with(double side, double least, int levels) {
 
 // A template at the sizes it was matched at: the object's size changes little from frame to
 // frame, so the same few sizes come back and need no resizing again.
+// Each is kept prepared for the direct NCC.
 class ScaledTemplates {
  public:
-  const cv::Mat& at(const cv::Mat& templ, cv::Size size) {
+  const DirectTemplate& at(const cv::Mat& templ, cv::Size size) {
     for (const auto& [s, m] : sizes_) {
       if (s == size) return m;
     }
     if (sizes_.size() >= kKept) sizes_.clear();
-    sizes_.emplace_back(size, resize_template(templ, size));
+    sizes_.emplace_back(size, DirectTemplate(resize_template(templ, size)));
     return sizes_.back().second;
   }
   void clear() { sizes_.clear(); }
 
  private:
   static constexpr std::size_t kKept = 16;
-  std::vector<std::pair<cv::Size, cv::Mat>> sizes_;
+  std::vector<std::pair<cv::Size, DirectTemplate>> sizes_;
 };
 
 // The best appearance match around a box: centre and size in level-0 pixels, and its NCC.

@@ -41,9 +41,6 @@ Appearance LocalTracker::Impl::match(const cv::Mat& appearance, ScaledTemplates&
   std::vector<double> log_scale(n);
   cv::Rect middle_window;
   int best = -1;
-  TemplateSearchParams tp;
-  tp.coarse_side = 0;
-  tp.scales = {1.0};  // the template comes resized
   // A wide search (the target lost) meets lookalikes: of nearly equal matches, the one nearer the
   // prediction wins.
   MatchPrior prior;
@@ -60,8 +57,8 @@ Appearance LocalTracker::Impl::match(const cv::Mat& appearance, ScaledTemplates&
     const cv::Rect window =
         enclosing(cv::Rect2f(static_cast<float>(at.x - half_w), static_cast<float>(at.y - half_h),
                              static_cast<float>(2 * half_w), static_cast<float>(2 * half_h)));
-    found[j] = match_template(image, sizes.at(appearance, scaled_size(appearance, scale)), window,
-                              tp, prior);
+    found[j] =
+        match_template(image, sizes.at(appearance, scaled_size(appearance, scale)), window, prior);
     if (j == middle) middle_window = window & cv::Rect(cv::Point(), image.size());
     // The size really matched: match_template rounds the scaled template to whole pixels.
     log_scale[j] = found[j].score > -1 ? 0.5 * std::log(static_cast<double>(found[j].box.area()) /

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 #ifdef __AVX2__
 #include <immintrin.h>
@@ -33,26 +34,31 @@ constexpr double kFlat = 1e-7;
 
 constexpr int kLanes = 8;
 
-// out[k] = sum over the template of t(r, c) * image(y + r, x + k + c), k = 0..count-1 (at most
-// 4); both zero-padded to whole vectors of kLanes. Four positions at once share each template
-// load and keep four independent sums in flight (one sum alone waits on its adds).
-void dot_windows(const cv::Mat& image, const cv::Mat& t, int x, int y, int count, float* out) {
+// out[k] = sum over the template of t(r, c) * image(r, c) from at[k], k = 0..count-1 (at most 4):
+// any four positions, in a row or not, both zero-padded to whole vectors of kLanes. Four
+// positions at once share each template load and keep four independent sums in flight (one sum
+// alone waits on its adds); a window a few positions wide fills its groups from the next rows.
+void dot_windows(const float* const* at, int stride, const cv::Mat& t, int count, float* out) {
   const int w = t.cols;
 #if defined(__AVX2__) && defined(__FMA__)
   // Four named accumulators, reduced all four at the end: indexing an array of them by the
   // runtime `count` would keep them in memory instead of registers.
   __m256 a0 = _mm256_setzero_ps(), a1 = _mm256_setzero_ps();
   __m256 a2 = _mm256_setzero_ps(), a3 = _mm256_setzero_ps();
+  const float *in0 = at[0], *in1 = at[1], *in2 = at[2], *in3 = at[3];
   for (int r = 0; r < t.rows; ++r) {
     const float* tr = t.ptr<float>(r);
-    const float* in = image.ptr<float>(y + r) + x;
     for (int c = 0; c < w; c += kLanes) {
       const __m256 tv = _mm256_loadu_ps(tr + c);
-      a0 = _mm256_fmadd_ps(tv, _mm256_loadu_ps(in + c), a0);
-      a1 = _mm256_fmadd_ps(tv, _mm256_loadu_ps(in + c + 1), a1);
-      a2 = _mm256_fmadd_ps(tv, _mm256_loadu_ps(in + c + 2), a2);
-      a3 = _mm256_fmadd_ps(tv, _mm256_loadu_ps(in + c + 3), a3);
+      a0 = _mm256_fmadd_ps(tv, _mm256_loadu_ps(in0 + c), a0);
+      a1 = _mm256_fmadd_ps(tv, _mm256_loadu_ps(in1 + c), a1);
+      a2 = _mm256_fmadd_ps(tv, _mm256_loadu_ps(in2 + c), a2);
+      a3 = _mm256_fmadd_ps(tv, _mm256_loadu_ps(in3 + c), a3);
     }
+    in0 += stride;
+    in1 += stride;
+    in2 += stride;
+    in3 += stride;
   }
   // Horizontal sums of the four: two rounds of hadd leave (a0, a1, a2, a3) per 128-bit half.
   const __m256 h01 = _mm256_hadd_ps(a0, a1), h23 = _mm256_hadd_ps(a2, a3);
@@ -65,11 +71,10 @@ void dot_windows(const cv::Mat& image, const cv::Mat& t, int x, int y, int count
   float acc[4][kLanes] = {};
   for (int r = 0; r < t.rows; ++r) {
     const float* tr = t.ptr<float>(r);
-    const float* in = image.ptr<float>(y + r) + x;
     for (int c = 0; c < w; c += kLanes)
       for (int k = 0; k < 4; ++k)
         for (int l = 0; l < kLanes; ++l)
-          acc[k][l] += tr[c + l] * in[c + k + l];
+          acc[k][l] += tr[c + l] * at[k][static_cast<std::ptrdiff_t>(r) * stride + c + l];
   }
   for (int k = 0; k < count; ++k) {
     out[k] = 0.f;
@@ -87,15 +92,46 @@ namespace {
 // a few-kilobyte image, and allocating them afresh each time cost more than the sums (glibc
 // returns the freed top of the heap to the system and faults it back in on the next call).
 struct DirectScratch {
-  std::vector<float> templ, image;  // centred, zero-padded rows
-  std::vector<double> sum, sqsum;   // integral images of the centred image, (rows+1) x (cols+1)
+  std::vector<float> image;        // centred, zero-padded rows
+  std::vector<double> sum, sqsum;  // integral images of the centred image, (rows+1) x (cols+1)
 };
 
 }  // namespace
 
+DirectTemplate::DirectTemplate(const cv::Mat& t) : templ(t) {
+  if (t.type() != CV_32FC1 || t.empty()) {
+    throw Error("template search: direct NCC needs a float template");
+  }
+  const int tw = t.cols, th = t.rows;
+  // Centred on its mean: NCC does not change, and the float sums lose far less to rounding
+  // than they would on raw intensities. Rows padded with zeros to whole vectors: each position's
+  // dot product is then whole-vector multiply-adds, reduced once per position.
+  stride = (tw + kLanes - 1) / kLanes * kLanes;
+  rows.resize(static_cast<std::size_t>(th) * stride);
+  const auto t_mean = static_cast<float>(cv::mean(t)[0]);
+  for (int y = 0; y < th; ++y) {
+    const float* src = t.ptr<float>(y);
+    float* dst = rows.data() + static_cast<std::size_t>(y) * stride;
+    float acc = 0.f;
+    for (int x = 0; x < tw; ++x) {
+      dst[x] = src[x] - t_mean;
+      acc += dst[x] * dst[x];
+    }
+    std::fill(dst + tw, dst + stride, 0.f);
+    norm2 += acc;
+  }
+}
+
 void ccoeff_normed_direct(const cv::Mat& image, const cv::Mat& templ, cv::Mat& response) {
-  if (image.type() != CV_32FC1 || templ.type() != CV_32FC1 || templ.cols > image.cols ||
-      templ.rows > image.rows || templ.empty()) {
+  if (templ.type() != CV_32FC1 || templ.empty()) {
+    throw Error("template search: direct NCC needs a float template no larger than the image");
+  }
+  ccoeff_normed_direct(image, DirectTemplate(templ), response);
+}
+
+void ccoeff_normed_direct(const cv::Mat& image, const DirectTemplate& prepared, cv::Mat& response) {
+  const cv::Mat& templ = prepared.templ;
+  if (image.type() != CV_32FC1 || templ.cols > image.cols || templ.rows > image.rows) {
     throw Error("template search: direct NCC needs a float template no larger than the image");
   }
   thread_local DirectScratch scratch;
@@ -103,61 +139,87 @@ void ccoeff_normed_direct(const cv::Mat& image, const cv::Mat& templ, cv::Mat& r
   const int iw = image.cols, ih = image.rows;
   const int nx = iw - tw + 1, ny = ih - th + 1;
   const double n = static_cast<double>(tw) * th;
-  // Both centred on their means: NCC does not change, and the float sums below lose far less
-  // to rounding than they would on raw intensities. Template rows padded with zeros to whole
-  // vectors, image rows with zeros past the end: each position's dot product is then
-  // whole-vector multiply-adds, reduced once per position.
-  const int twp = (tw + kLanes - 1) / kLanes * kLanes;
+  // The image centred on its mean like the template (DirectTemplate), its rows padded with
+  // zeros past the end.
+  const int twp = prepared.stride;
   const int ipw = iw + twp + 4;
   // Only what is read is written: zeroing whole buffers on every call cost as much as the sums
   // (the padding is zeroed row by row below; an integral image's first row and column here).
-  scratch.templ.resize(static_cast<std::size_t>(th) * twp);
   scratch.image.resize(static_cast<std::size_t>(ih) * ipw);
-  const cv::Mat tp(th, twp, CV_32F, scratch.templ.data());
+  const cv::Mat tp(th, twp, CV_32F, const_cast<float*>(prepared.rows.data()));
   const cv::Mat ip(ih, ipw, CV_32F, scratch.image.data());
-  const auto t_mean = static_cast<float>(cv::mean(templ)[0]);
   const auto i_mean = static_cast<float>(cv::mean(image)[0]);
-  double t_norm2 = 0;
-  for (int y = 0; y < th; ++y) {
-    const float* src = templ.ptr<float>(y);
-    float* dst = scratch.templ.data() + static_cast<std::size_t>(y) * twp;
-    float acc = 0.f;
-    for (int x = 0; x < tw; ++x) {
-      dst[x] = src[x] - t_mean;
-      acc += dst[x] * dst[x];
-    }
-    std::fill(dst + tw, dst + twp, 0.f);
-    t_norm2 += acc;
-  }
+  const double t_norm2 = prepared.norm2;
   const std::size_t sw = static_cast<std::size_t>(iw) + 1;
   scratch.sum.resize(sw * (ih + 1));
   scratch.sqsum.resize(sw * (ih + 1));
   std::fill_n(scratch.sum.begin(), sw, 0.0);
   std::fill_n(scratch.sqsum.begin(), sw, 0.0);
-  for (int y = 0; y < ih; ++y) {
-    const float* src = image.ptr<float>(y);
-    float* dst = scratch.image.data() + static_cast<std::size_t>(y) * ipw;
-    const double* s_up = scratch.sum.data() + y * sw;
-    const double* q_up = scratch.sqsum.data() + y * sw;
-    double* s_row = scratch.sum.data() + (y + 1) * sw;
-    double* q_row = scratch.sqsum.data() + (y + 1) * sw;
-    double s = 0, q = 0;
-    s_row[0] = 0.0;
-    q_row[0] = 0.0;
-    for (int x = 0; x < iw; ++x) {
-      dst[x] = src[x] - i_mean;
-      s += dst[x];
-      q += static_cast<double>(dst[x]) * dst[x];
-      s_row[x + 1] = s_up[x + 1] + s;
-      q_row[x + 1] = q_up[x + 1] + q;
+  // Integral images, kRows rows at a time: each row's running sums are a chain of dependent
+  // adds, so rows side by side keep several chains in flight (the same adds in the same order
+  // per row as one row at a time).
+  constexpr int kRows = 4;
+  for (int y0 = 0; y0 < ih; y0 += kRows) {
+    const int rows = std::min(kRows, ih - y0);
+    const float* src[kRows];
+    float* dst[kRows];
+    double* s_row[kRows];
+    double* q_row[kRows];
+    double s[kRows] = {}, q[kRows] = {};
+    for (int k = 0; k < kRows; ++k) {
+      const int y = y0 + std::min(k, rows - 1);
+      src[k] = image.ptr<float>(y);
+      dst[k] = scratch.image.data() + static_cast<std::size_t>(y) * ipw;
+      s_row[k] = scratch.sum.data() + (y + 1) * sw;
+      q_row[k] = scratch.sqsum.data() + (y + 1) * sw;
+      s_row[k][0] = 0.0;
+      q_row[k][0] = 0.0;
     }
-    std::fill(dst + iw, dst + ipw, 0.f);
+    const double* s_up = scratch.sum.data() + y0 * sw;
+    const double* q_up = scratch.sqsum.data() + y0 * sw;
+    if (rows == kRows) {
+      for (int x = 0; x < iw; ++x) {
+        for (int k = 0; k < kRows; ++k) {
+          const float d = src[k][x] - i_mean;
+          dst[k][x] = d;
+          s[k] += d;
+          q[k] += static_cast<double>(d) * d;
+          s_row[k][x + 1] = (k == 0 ? s_up : s_row[k - 1])[x + 1] + s[k];
+          q_row[k][x + 1] = (k == 0 ? q_up : q_row[k - 1])[x + 1] + q[k];
+        }
+      }
+    } else {
+      for (int k = 0; k < rows; ++k) {
+        const double* su = k == 0 ? s_up : s_row[k - 1];
+        const double* qu = k == 0 ? q_up : q_row[k - 1];
+        for (int x = 0; x < iw; ++x) {
+          const float d = src[k][x] - i_mean;
+          dst[k][x] = d;
+          s[k] += d;
+          q[k] += static_cast<double>(d) * d;
+          s_row[k][x + 1] = su[x + 1] + s[k];
+          q_row[k][x + 1] = qu[x + 1] + q[k];
+        }
+      }
+    }
+    for (int k = 0; k < rows; ++k)
+      std::fill(dst[k] + iw, dst[k] + ipw, 0.f);
   }
   response.create(ny, nx, CV_32F);
+  // The positions in row-major order, four at a time (the last group repeats its last one).
+  const int positions = nx * ny;
+  float* res = response.ptr<float>(0);
+  for (int p = 0; p < positions; p += 4) {
+    const int count = std::min(4, positions - p);
+    const float* at[4];
+    for (int k = 0; k < 4; ++k) {
+      const int q = p + std::min(k, count - 1);
+      at[k] = ip.ptr<float>(q / nx) + q % nx;
+    }
+    dot_windows(at, ipw, tp, count, res + p);
+  }
   for (int y = 0; y < ny; ++y) {
     float* out = response.ptr<float>(y);
-    for (int x = 0; x < nx; x += 4)
-      dot_windows(ip, tp, x, y, std::min(4, nx - x), out + x);
     const double* s0 = scratch.sum.data() + y * sw;
     const double* s1 = scratch.sum.data() + (y + th) * sw;
     const double* q0 = scratch.sqsum.data() + y * sw;
@@ -205,16 +267,21 @@ bool prior_on(const MatchPrior& p) {
   return p.radius > 0 && p.penalty > 0;
 }
 
-// Best full-resolution match of `templ` (already scaled) in `region` of `image`.
+// Best full-resolution match of `templ` (already scaled; `prepared` when the caller has it) in
+// `region` of `image`.
 TemplateMatch match_one(const cv::Mat& image, const cv::Mat& templ, const cv::Rect& region,
-                        const MatchPrior& prior = {}) {
+                        const MatchPrior& prior = {}, const DirectTemplate* prepared = nullptr) {
   TemplateMatch best;
   if (region.width < templ.cols || region.height < templ.rows) return best;
   thread_local cv::Mat response;  // reused: see DirectScratch
   const double work = static_cast<double>(region.width - templ.cols + 1) *
                       (region.height - templ.rows + 1) * templ.total();
   if (image.depth() == CV_32F && work <= kDirectLimit) {
-    ccoeff_normed_direct(image(region), templ, response);
+    if (prepared != nullptr) {
+      ccoeff_normed_direct(image(region), *prepared, response);
+    } else {
+      ccoeff_normed_direct(image(region), templ, response);
+    }
   } else {
     cv::matchTemplate(image(region), templ, response, cv::TM_CCOEFF_NORMED);
   }
@@ -265,6 +332,22 @@ TemplateMatch match_one(const cv::Mat& image, const cv::Mat& templ, const cv::Re
 }
 
 }  // namespace
+
+TemplateMatch match_template(const cv::Mat& image, const DirectTemplate& templ,
+                             const cv::Rect& search, const MatchPrior& prior) {
+  if (image.empty()) throw Error("template search: empty image or template");
+  if (image.type() != CV_32FC1) {
+    throw Error("template search: a prepared template needs a float image, got " +
+                cv::typeToString(image.type()));
+  }
+  if (!(prior.radius >= 0 && prior.penalty >= 0)) {
+    throw Error("template search: the prior's radius and penalty must be >= 0");
+  }
+  const cv::Rect region = search & cv::Rect(0, 0, image.cols, image.rows);
+  if (region.empty()) return {};
+  const TemplateMatch m = match_one(image, templ.templ, region, prior, &templ);
+  return m.score > -1 ? m : TemplateMatch{};
+}
 
 TemplateMatch match_template(const cv::Mat& image, const cv::Mat& templ, const cv::Rect& search,
                              const TemplateSearchParams& params, const MatchPrior& prior) {

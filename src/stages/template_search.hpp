@@ -51,4 +51,19 @@ cv::Mat resize_template(const cv::Mat& templ, cv::Size size);
 // template no larger than the image; response is (rows, cols) = image - template + 1.
 void ccoeff_normed_direct(const cv::Mat& image, const cv::Mat& templ, cv::Mat& response);
 
+// A float template made ready for ccoeff_normed_direct once (centred on its mean, rows padded,
+// its sum of squares): a caller that matches the same template many times prepares it once.
+// Throws roiflow::Error on an empty or non-float template.
+struct DirectTemplate {
+  explicit DirectTemplate(const cv::Mat& templ);
+  cv::Mat templ;            // CV_32FC1, as given
+  std::vector<float> rows;  // centred, each row padded with zeros to `stride` floats
+  int stride = 0;
+  double norm2 = 0;  // sum of squares of the centred template
+};
+void ccoeff_normed_direct(const cv::Mat& image, const DirectTemplate& templ, cv::Mat& response);
+// match_template at scale 1 (no coarse pass) of a prepared template: the same result.
+TemplateMatch match_template(const cv::Mat& image, const DirectTemplate& templ,
+                             const cv::Rect& search, const MatchPrior& prior = {});
+
 }  // namespace roiflow::stages

@@ -135,5 +135,48 @@ TEST(TemplateSearch, DirectNccEqualsOpenCvsMatchTemplate) {
             std::string::npos);
 }
 
+// The tracker's searches: a few positions per row (groups of four span rows) and image heights
+// that are not whole groups of the integral images' four rows.
+TEST(TemplateSearch, DirectNccOnSmallWindowsEqualsOpenCvs) {
+  cv::RNG rng(11);
+  for (const cv::Size positions :
+       {cv::Size(6, 6), cv::Size(5, 7), cv::Size(1, 3), cv::Size(9, 2)}) {
+    for (const cv::Size templ_size : {cv::Size(39, 23), cv::Size(8, 5), cv::Size(17, 30)}) {
+      cv::Mat image(templ_size.height + positions.height - 1,
+                    templ_size.width + positions.width - 1, CV_32F);
+      cv::Mat templ(templ_size, CV_32F);
+      rng.fill(image, cv::RNG::UNIFORM, 0.f, 1.f);
+      rng.fill(templ, cv::RNG::UNIFORM, 0.f, 1.f);
+      cv::Mat direct, reference;
+      ccoeff_normed_direct(image, templ, direct);
+      cv::matchTemplate(image, templ, reference, cv::TM_CCOEFF_NORMED);
+      ASSERT_EQ(direct.size(), positions);
+      EXPECT_LT(cv::norm(direct, reference, cv::NORM_INF), 1e-4)
+          << positions << " positions, template " << templ_size;
+    }
+  }
+}
+
+// A template prepared once matches as the template itself does, prior and all.
+TEST(TemplateSearch, APreparedTemplateMatchesAsTheTemplate) {
+  cv::Mat image, patch;
+  texture({160, 120}, 5).convertTo(image, CV_32F, 1.0 / 255);
+  image(cv::Rect(70, 40, 33, 21)).copyTo(patch);
+  const DirectTemplate prepared(patch);
+  for (const MatchPrior prior : {MatchPrior{}, MatchPrior{{60.f, 50.f}, 20, 0.2}}) {
+    for (const cv::Rect search : {cv::Rect(60, 30, 50, 40), cv::Rect(66, 37, 40, 27),
+                                  cv::Rect(150, 100, 40, 40), cv::Rect(0, 0, 20, 20)}) {
+      const TemplateMatch a = match_template(image, patch, search, {{1.0}, 0}, prior);
+      const TemplateMatch b = match_template(image, prepared, search, prior);
+      EXPECT_EQ(a.score, b.score) << search;
+      EXPECT_EQ(a.ranked, b.ranked) << search;
+      EXPECT_EQ(a.box, b.box) << search;
+    }
+  }
+  EXPECT_GT(match_template(image, prepared, cv::Rect(60, 30, 50, 40)).score, 0.99);
+  EXPECT_NE(error_message([&] { DirectTemplate{cv::Mat(3, 3, CV_8U)}; }).find("float"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace roiflow::stages
