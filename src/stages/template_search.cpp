@@ -97,60 +97,12 @@ struct DirectScratch {
   std::vector<double> sum, sqsum;  // integral images of the centred image, (rows+1) x (cols+1)
 };
 
-}  // namespace
-
-DirectTemplate::DirectTemplate(const cv::Mat& t) : templ(t) {
-  if (t.type() != CV_32FC1 || t.empty()) {
-    throw Error("template search: direct NCC needs a float template");
-  }
-  const int tw = t.cols, th = t.rows;
-  // Centred on its mean: NCC does not change, and the float sums lose far less to rounding
-  // than they would on raw intensities. Rows padded with zeros to whole vectors: each position's
-  // dot product is then whole-vector multiply-adds, reduced once per position.
-  stride = (tw + kLanes - 1) / kLanes * kLanes;
-  rows.resize(static_cast<std::size_t>(th) * stride);
-  const auto t_mean = static_cast<float>(cv::mean(t)[0]);
-  for (int y = 0; y < th; ++y) {
-    const float* src = t.ptr<float>(y);
-    float* dst = rows.data() + static_cast<std::size_t>(y) * stride;
-    float acc = 0.f;
-    for (int x = 0; x < tw; ++x) {
-      dst[x] = src[x] - t_mean;
-      acc += dst[x] * dst[x];
-    }
-    std::fill(dst + tw, dst + stride, 0.f);
-    norm2 += acc;
-  }
-}
-
-void ccoeff_normed_direct(const cv::Mat& image, const cv::Mat& templ, cv::Mat& response) {
-  if (templ.type() != CV_32FC1 || templ.empty()) {
-    throw Error("template search: direct NCC needs a float template no larger than the image");
-  }
-  ccoeff_normed_direct(image, DirectTemplate(templ), response);
-}
-
-void ccoeff_normed_direct(const cv::Mat& image, const DirectTemplate& prepared, cv::Mat& response) {
-  const cv::Mat& templ = prepared.templ;
-  if (image.type() != CV_32FC1 || templ.cols > image.cols || templ.rows > image.rows) {
-    throw Error("template search: direct NCC needs a float template no larger than the image");
-  }
-  thread_local DirectScratch scratch;
-  const int tw = templ.cols, th = templ.rows;
+// The image centred on `i_mean` into scratch.image (rows ipw floats apart, zero-padded past the
+// end) and the integral images of its values and squares into scratch.sum and scratch.sqsum
+// ((rows + 1) x (cols + 1)), for windows tw wide at nx positions a row.
+void centre_and_integrate(const cv::Mat& image, float i_mean, int nx, int tw, int ipw,
+                          DirectScratch& scratch) {
   const int iw = image.cols, ih = image.rows;
-  const int nx = iw - tw + 1, ny = ih - th + 1;
-  const double n = static_cast<double>(tw) * th;
-  // The image centred on its mean like the template (DirectTemplate), its rows padded with
-  // zeros past the end.
-  const int twp = prepared.stride;
-  const int ipw = iw + twp + 4;
-  // Only what is read is written: zeroing whole buffers on every call cost as much as the sums
-  // (the padding is zeroed row by row below; an integral image's first row and column here).
-  scratch.image.resize(static_cast<std::size_t>(ih) * ipw);
-  const cv::Mat tp(th, twp, CV_32F, const_cast<float*>(prepared.rows.data()));
-  const cv::Mat ip(ih, ipw, CV_32F, scratch.image.data());
-  const auto i_mean = static_cast<float>(cv::mean(image)[0]);
-  const double t_norm2 = prepared.norm2;
   const std::size_t sw = static_cast<std::size_t>(iw) + 1;
   scratch.sum.resize(sw * (ih + 1));
   scratch.sqsum.resize(sw * (ih + 1));
@@ -234,6 +186,64 @@ void ccoeff_normed_direct(const cv::Mat& image, const DirectTemplate& prepared, 
     for (int k = 0; k < rows; ++k)
       std::fill(dst[k] + iw, dst[k] + ipw, 0.f);
   }
+}
+
+}  // namespace
+
+DirectTemplate::DirectTemplate(const cv::Mat& t) : templ(t) {
+  if (t.type() != CV_32FC1 || t.empty()) {
+    throw Error("template search: direct NCC needs a float template");
+  }
+  const int tw = t.cols, th = t.rows;
+  // Centred on its mean: NCC does not change, and the float sums lose far less to rounding
+  // than they would on raw intensities. Rows padded with zeros to whole vectors: each position's
+  // dot product is then whole-vector multiply-adds, reduced once per position.
+  stride = (tw + kLanes - 1) / kLanes * kLanes;
+  rows.resize(static_cast<std::size_t>(th) * stride);
+  const auto t_mean = static_cast<float>(cv::mean(t)[0]);
+  for (int y = 0; y < th; ++y) {
+    const float* src = t.ptr<float>(y);
+    float* dst = rows.data() + static_cast<std::size_t>(y) * stride;
+    float acc = 0.f;
+    for (int x = 0; x < tw; ++x) {
+      dst[x] = src[x] - t_mean;
+      acc += dst[x] * dst[x];
+    }
+    std::fill(dst + tw, dst + stride, 0.f);
+    norm2 += acc;
+  }
+}
+
+void ccoeff_normed_direct(const cv::Mat& image, const cv::Mat& templ, cv::Mat& response) {
+  if (templ.type() != CV_32FC1 || templ.empty()) {
+    throw Error("template search: direct NCC needs a float template no larger than the image");
+  }
+  ccoeff_normed_direct(image, DirectTemplate(templ), response);
+}
+
+void ccoeff_normed_direct(const cv::Mat& image, const DirectTemplate& prepared, cv::Mat& response) {
+  const cv::Mat& templ = prepared.templ;
+  if (image.type() != CV_32FC1 || templ.cols > image.cols || templ.rows > image.rows) {
+    throw Error("template search: direct NCC needs a float template no larger than the image");
+  }
+  thread_local DirectScratch scratch;
+  const int tw = templ.cols, th = templ.rows;
+  const int iw = image.cols, ih = image.rows;
+  const int nx = iw - tw + 1, ny = ih - th + 1;
+  const double n = static_cast<double>(tw) * th;
+  // The image centred on its mean like the template (DirectTemplate), its rows padded with
+  // zeros past the end.
+  const int twp = prepared.stride;
+  const int ipw = iw + twp + 4;
+  // Only what is read is written: zeroing whole buffers on every call cost as much as the sums
+  // (the padding is zeroed row by row below; an integral image's first row and column here).
+  scratch.image.resize(static_cast<std::size_t>(ih) * ipw);
+  const cv::Mat tp(th, twp, CV_32F, const_cast<float*>(prepared.rows.data()));
+  const cv::Mat ip(ih, ipw, CV_32F, scratch.image.data());
+  const auto i_mean = static_cast<float>(cv::mean(image)[0]);
+  const double t_norm2 = prepared.norm2;
+  const std::size_t sw = static_cast<std::size_t>(iw) + 1;
+  centre_and_integrate(image, i_mean, nx, tw, ipw, scratch);
   response.create(ny, nx, CV_32F);
   // The positions in row-major order, four at a time (the last group repeats its last one).
   const int positions = nx * ny;
