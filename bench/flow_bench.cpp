@@ -8,7 +8,8 @@
 //                                          roiflow_paper_l4f1r (variants of paper, see
 //                                          docs/PERFORMANCE.md), dis_ultrafast, dis_fast,
 //                                          dis_medium, farneback
-//   BM_TwoThreadBound/<paper|fast>/<W>x<H>  one pair's two-thread schedule timed on the CPU clock
+//   BM_TwoThreadBound/<paper|fast|accurate>/<W>x<H>  one pair's two-thread schedule timed on the
+//   CPU clock
 //                                          of one thread: speedup2, what two idle cores would give
 //   BM_Pyramid/<W>x<H>                     build_pyramid(frame) alone (paper preset), 1 thread
 //   BM_Pretreatment/<roiflow|opencv>/<W>x<H>  level 0 alone (sigma 0.5): roiflow's fused pass vs
@@ -387,7 +388,7 @@ void register_benchmarks() {
             ->UseRealTime();
       }
     }
-    for (const char* preset : {"paper", "fast"}) {
+    for (const char* preset : {"paper", "fast", "accurate"}) {
       benchmark::RegisterBenchmark(
           ("BM_TwoThreadBound/" + std::string(preset) + "/" + size_name(size)).c_str(),
           bm_two_thread_bound, roiflow::flow::LkParams::preset(preset), size)

@@ -52,11 +52,11 @@ cv::Mat padded(const cv::Mat& b, int pad) {
   return out;
 }
 
-// Every pixel of `a` matched in `b` at each displacement of `order` (around `prior`): the
-// window costs of one displacement stream through a StreamingZssd row by row, and each row
+// Every pixel of `a` matched in `b` at the displacements order[first, last) (around `prior`):
+// the window costs of one displacement stream through a StreamingZssd row by row, and each row
 // updates the running best forward and, at the targets, backward.
-Matches match(const cv::Mat& a, const cv::Mat& b_padded, int pad, cv::Point prior,
-              const std::vector<Displacement>& order, int window) {
+Matches match_range(const cv::Mat& a, const cv::Mat& b_padded, int pad, cv::Point prior,
+                    const std::vector<Displacement>& order, int first, int last, int window) {
   const int w = a.cols, h = a.rows;
   const std::size_t n = static_cast<std::size_t>(w) * h;
   Matches m;
@@ -69,7 +69,8 @@ Matches match(const cv::Mat& a, const cv::Mat& b_padded, int pad, cv::Point prio
   m.back_cost.assign(n, std::numeric_limits<float>::infinity());
   detail::StreamingZssd z(w, h, window);
   std::vector<float> cost_row;
-  for (const Displacement& s : order) {
+  for (int i = first; i < last; ++i) {
+    const Displacement& s = order[static_cast<std::size_t>(i)];
     const int du = prior.x + s.dx, dv = prior.y + s.dy;
     const bool at_prior = s.dx == 0 && s.dy == 0;
     const auto fill = [&](int y, float* __restrict d) {
@@ -106,6 +107,44 @@ Matches match(const cv::Mat& a, const cv::Mat& b_padded, int pad, cv::Point prio
       }
     };
     detail::for_each_cost_row(z, fill, use, cost_row);
+  }
+  return m;
+}
+
+// match_range over all of `order`. With an executor of two threads or more, contiguous parts
+// of `order` side by side, then merged in order: a later part's best replaces the earlier one's
+// only where it is strictly better, which is what one running best over the whole order keeps
+// (the first displacement of the smallest cost), so the result is the one-thread result.
+Matches match(const cv::Mat& a, const cv::Mat& b_padded, int pad, cv::Point prior,
+              const std::vector<Displacement>& order, int window, const Executor* executor) {
+  const int count = static_cast<int>(order.size());
+  if (!executor || executor->concurrency() < 2 || count < 2) {
+    return match_range(a, b_padded, pad, prior, order, 0, count, window);
+  }
+  const int parts = std::min(count, 2 * executor->concurrency());
+  std::vector<Matches> part(static_cast<std::size_t>(parts));
+  executor->for_range(0, parts, 1, [&](int p0, int p1) {
+    for (int p = p0; p < p1; ++p) {
+      part[static_cast<std::size_t>(p)] = match_range(
+          a, b_padded, pad, prior, order, count * p / parts, count * (p + 1) / parts, window);
+    }
+  });
+  Matches m = std::move(part[0]);  // holds order[0], the prior itself, and so its costs
+  const std::size_t n = m.cost.size();
+  for (int p = 1; p < parts; ++p) {
+    const Matches& q = part[static_cast<std::size_t>(p)];
+    for (std::size_t i = 0; i < n; ++i) {
+      if (q.cost[i] < m.cost[i]) {
+        m.cost[i] = q.cost[i];
+        m.du[i] = q.du[i];
+        m.dv[i] = q.dv[i];
+      }
+      if (q.back_cost[i] < m.back_cost[i]) {
+        m.back_cost[i] = q.back_cost[i];
+        m.back_du[i] = q.back_du[i];
+        m.back_dv[i] = q.back_dv[i];
+      }
+    }
   }
   return m;
 }
@@ -171,7 +210,7 @@ int search_radius_for(cv::Size size, int level, double expected_motion, int max_
 }
 
 void search_flow(const cv::Mat& i0, const cv::Mat& i1, cv::Point2f prior,
-                 const SearchParams& params, cv::Mat& u, cv::Mat& v) {
+                 const SearchParams& params, cv::Mat& u, cv::Mat& v, const Executor* executor) {
   check_search(i0, i1, params, u, v);
   const int w = i0.cols, h = i0.rows;
   const std::size_t n = static_cast<std::size_t>(w) * h;
@@ -180,7 +219,7 @@ void search_flow(const cv::Mat& i0, const cv::Mat& i1, cv::Point2f prior,
                     std::clamp(static_cast<int>(std::lround(prior.y)), -h, h));
   const int pad = params.radius + std::max(std::abs(p.x), std::abs(p.y));
   const std::vector<Displacement> order = spiral(params.radius);
-  const Matches fwd = match(i0, padded(i1, pad), pad, p, order, params.window);
+  const Matches fwd = match(i0, padded(i1, pad), pad, p, order, params.window, executor);
 
   std::vector<std::uint8_t> reliable(n);
   const float tol2 = params.fb_tolerance * params.fb_tolerance;
@@ -240,7 +279,8 @@ bool seeds_level(const LkParams& params, int level, int levels, const FlowOption
 }
 
 void seed_level(const LkParams& params, const cv::Mat& i0, const cv::Mat& i1, const cv::Rect& c,
-                int level, int levels, const FlowOptions& options, cv::Mat& u, cv::Mat& v) {
+                int level, int levels, const FlowOptions& options, cv::Mat& u, cv::Mat& v,
+                const Executor* executor, std::vector<float>* scratch) {
   // A region works on its own rectangle, read as if the frame ended there.
   const cv::Mat a = i0(c), b = i1(c);
   if (level == levels - 1 && params.search_radius > 0 && options.initial_flow.empty()) {
@@ -248,13 +288,13 @@ void seed_level(const LkParams& params, const cv::Mat& i0, const cv::Mat& i1, co
     search.radius = search_radius_for(i0.size() * (1 << level), level, params.expected_motion,
                                       params.search_radius);
     const float scale = 1.f / static_cast<float>(1 << level);
-    search_flow(a, b, options.initial_motion * scale, search, u, v);
+    search_flow(a, b, options.initial_motion * scale, search, u, v, executor);
   }
   // Far candidates first: they carry a motion over a distance the near ones then refine.
   if (params.fuse_far_step > 0 && level >= params.fuse_far_finest_level)
-    fuse_candidates(a, b, params.fuse_far_step, kFuseWindow, u, v);
+    fuse_candidates(a, b, params.fuse_far_step, kFuseWindow, u, v, executor, scratch);
   if (params.fuse_step > 0 && level >= params.fuse_finest_level)
-    fuse_candidates(a, b, params.fuse_step, kFuseWindow, u, v);
+    fuse_candidates(a, b, params.fuse_step, kFuseWindow, u, v, executor, scratch);
 }
 
 }  // namespace detail

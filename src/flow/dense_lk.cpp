@@ -26,9 +26,10 @@ struct DenseLK::Workspace {
   cv::Mat seed_u, seed_v;     // a level's starting flow, when large_motion.hpp seeds it
   cv::Mat confidence;         // the finest level's
   detail::LevelScratch scratch;
+  std::vector<float> fusion;  // the candidate fusion's costs, with threads
 
   std::size_t bytes() const {
-    std::size_t n = scratch.bytes();
+    std::size_t n = scratch.bytes() + fusion.capacity() * sizeof(float);
     for (const cv::Mat* m : {&init_u, &init_v, &seed_u, &seed_v, &confidence})
       n += m->total() * m->elemSize();
     for (const std::vector<cv::Mat>* mats : {&pyr_t.levels, &pyr_t1.levels, &u, &v}) {
@@ -234,7 +235,7 @@ void flow_from_pyramids(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkPar
       // The coarse search and the candidate fusion work on the level's starting flow as planes.
       starting_planes(input, c, ws.seed_u, ws.seed_v);
       detail::seed_level(params, pyr_t.levels[l], pyr_t1.levels[l], c, l, levels, options,
-                         ws.seed_u, ws.seed_v);
+                         ws.seed_u, ws.seed_v, &exec, &ws.fusion);
       input = LevelInput::planes(ws.seed_u, ws.seed_v);
     }
     const LevelProblem p = level_problem(pyr_t.levels[l], pyr_t1.levels[l], c, params);

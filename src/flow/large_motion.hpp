@@ -17,7 +17,9 @@
 #pragma once
 
 #include <opencv2/core.hpp>
+#include <vector>
 
+#include "core/executor.hpp"
 #include "flow/dense_lk.hpp"
 
 namespace roiflow::flow {
@@ -48,18 +50,24 @@ struct SearchParams {
 
 // Coarse search of `i0`'s pixels in `i1` (same size as i0, u and v) around `prior` (level
 // pixels): u, v become each pixel's reliable integer displacement, or its fill (see above).
-// Frame borders are replicated. Throws roiflow::Error on mismatched inputs or parameters out
-// of range (radius 1..kMaxSearchRadius, window odd 3..15, tolerance >= 0, margin in [0, 1)).
+// Frame borders are replicated. With an executor of two threads or more, parts of the
+// displacements are searched side by side, with the same result. Throws roiflow::Error on
+// mismatched inputs or parameters out of range (radius 1..kMaxSearchRadius, window odd 3..15,
+// tolerance >= 0, margin in [0, 1)).
 void search_flow(const cv::Mat& i0, const cv::Mat& i1, cv::Point2f prior,
-                 const SearchParams& params, cv::Mat& u, cv::Mat& v);
+                 const SearchParams& params, cv::Mat& u, cv::Mat& v,
+                 const Executor* executor = nullptr);
 
 // Candidate fusion: each pixel keeps its own flow or takes that of the pixel `step` away in
 // one of the 8 directions, whichever has the smallest zero-mean SSD over a `window` x `window`
 // window (frame t+1 warped bilinearly, borders replicated); ties keep the pixel's own. One pass,
-// all pixels at once. Throws roiflow::Error on mismatched inputs, step < 1 or a window that is
-// not odd in 3..15.
+// all pixels at once. With an executor of two threads or more the nine candidates' costs are
+// computed side by side (into `scratch` when given, kept for the next call; nine floats per
+// pixel) and folded in rows, with the same result. Throws roiflow::Error on mismatched inputs,
+// step < 1 or a window that is not odd in 3..15.
 void fuse_candidates(const cv::Mat& i0, const cv::Mat& i1, int step, int window, cv::Mat& u,
-                     cv::Mat& v);
+                     cv::Mat& v, const Executor* executor = nullptr,
+                     std::vector<float>* scratch = nullptr);
 
 namespace detail {
 
@@ -75,7 +83,8 @@ bool seeds_level(const LkParams& params, int level, int levels, const FlowOption
 // and the near candidate fusion, as `params` ask. A region is searched within its own
 // rectangle.
 void seed_level(const LkParams& params, const cv::Mat& i0, const cv::Mat& i1, const cv::Rect& c,
-                int level, int levels, const FlowOptions& options, cv::Mat& u, cv::Mat& v);
+                int level, int levels, const FlowOptions& options, cv::Mat& u, cv::Mat& v,
+                const Executor* executor = nullptr, std::vector<float>* scratch = nullptr);
 
 }  // namespace detail
 

@@ -5,10 +5,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <opencv2/imgproc.hpp>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "core/error.hpp"
 #include "flow/dense_lk.hpp"
@@ -152,6 +155,63 @@ TEST(CandidateFusionTest, AWrongBandTakesItsNeighboursFlow) {
   v.colRange(38, 41).setTo(0.f);
   fuse_candidates(i0, i1, 4, 7, u, v);
   EXPECT_EQ(share_exact(u, v, {6, 6, 68, 48}, 2.5f, -1.25f), 1.0);
+}
+
+// An executor that claims two threads and runs the chunks one by one, the last first: the
+// threaded schedule of fuse_candidates, in an order no serial loop would take.
+class ReversedChunks final : public Executor {
+ public:
+  void for_range(int begin, int end, int grain,
+                 const std::function<void(int, int)>& body) const override {
+    const int step = std::max(1, grain);
+    std::vector<std::pair<int, int>> chunks;
+    for (int b = begin; b < end; b += step)
+      chunks.emplace_back(b, std::min(end, b + step));
+    for (auto it = chunks.rbegin(); it != chunks.rend(); ++it)
+      it->first < it->second ? body(it->first, it->second) : void();
+    calls += static_cast<int>(chunks.size());
+  }
+  int concurrency() const override { return 2; }
+  mutable int calls = 0;
+};
+
+TEST(CandidateFusionTest, ThreadedScheduleGivesTheSerialResultBitForBit) {
+  const cv::Mat i0 = texture({83, 61}, 8);
+  const cv::Mat i1 = moved(i0, {1.75f, 2.5f});
+  // A start with several motions, so that every candidate direction wins somewhere.
+  const cv::Mat u0 = texture({83, 61}, 9) * 6.f, v0 = texture({83, 61}, 10) * -5.f;
+  std::vector<float> scratch;  // kept across the calls, as DenseLK keeps it
+  for (const int step : {1, 4, 16}) {
+    cv::Mat u = u0.clone(), v = v0.clone();
+    fuse_candidates(i0, i1, step, 7, u, v);
+    EXPECT_GT(cv::norm(u, u0, cv::NORM_INF), 0.0) << "step " << step;
+    for (const bool own_scratch : {false, true}) {
+      cv::Mat tu = u0.clone(), tv = v0.clone();
+      const ReversedChunks two;
+      fuse_candidates(i0, i1, step, 7, tu, tv, &two, own_scratch ? nullptr : &scratch);
+      EXPECT_GT(two.calls, 9) << "step " << step;
+      EXPECT_EQ(cv::norm(u, tu, cv::NORM_INF), 0.0) << "step " << step;
+      EXPECT_EQ(cv::norm(v, tv, cv::NORM_INF), 0.0) << "step " << step;
+    }
+  }
+}
+
+TEST(CoarseSearchTest, ThreadedScheduleGivesTheSerialResultBitForBit) {
+  const cv::Mat i0 = texture({71, 53}, 11);
+  const cv::Mat i1 = moved(i0, {6.f, -4.f});
+  for (const int radius : {3, 8}) {
+    SearchParams params;
+    params.radius = radius;
+    cv::Mat u(i0.size(), CV_32F, 0.f), v(i0.size(), CV_32F, 0.f);
+    search_flow(i0, i1, {0.5f, 0.f}, params, u, v);
+    cv::Mat tu(i0.size(), CV_32F, 0.f), tv(i0.size(), CV_32F, 0.f);
+    const ReversedChunks two;
+    search_flow(i0, i1, {0.5f, 0.f}, params, tu, tv, &two);
+    EXPECT_GT(two.calls, 2) << "radius " << radius;
+    EXPECT_GT(cv::countNonZero(u != 0.f), 0) << "radius " << radius;
+    EXPECT_EQ(cv::norm(u, tu, cv::NORM_INF), 0.0) << "radius " << radius;
+    EXPECT_EQ(cv::norm(v, tv, cv::NORM_INF), 0.0) << "radius " << radius;
+  }
 }
 
 TEST(CandidateFusionTest, FlatFramesKeepEveryPixelsOwnFlow) {
