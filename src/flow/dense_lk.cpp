@@ -110,10 +110,16 @@ void confidence_to_level0(const cv::Mat& src, const cv::Rect& from, int level,
   std::vector<int> column(region.width);
   for (int x = 0; x < region.width; ++x)
     column[x] = std::clamp(((region.x + x + half) >> level) - from.x, 0, src.cols - 1);
+  int last = -1;  // the level row that row y - 1 was sampled from
   for (int y = y0; y < y1; ++y) {
     const int sy = std::clamp(((region.y + y + half) >> level) - from.y, 0, src.rows - 1);
-    const float* in = src.ptr<float>(sy);
     float* o = out.ptr<float>(y);
+    if (sy == last) {  // 2^level rows in a row read the same level row
+      std::copy_n(out.ptr<float>(y - 1), region.width, o);
+      continue;
+    }
+    last = sy;
+    const float* in = src.ptr<float>(sy);
     for (int x = 0; x < region.width; ++x)
       o[x] = in[column[x]];
   }

@@ -9,6 +9,7 @@
 #endif
 #include <opencv2/imgproc.hpp>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "core/error.hpp"
@@ -96,6 +97,97 @@ struct DirectScratch {
   std::vector<double> sum, sqsum;  // integral images of the centred image, (rows+1) x (cols+1)
 };
 
+// The image centred on `i_mean` into scratch.image (rows ipw floats apart, zero-padded past the
+// end) and the integral images of its values and squares into scratch.sum and scratch.sqsum
+// ((rows + 1) x (cols + 1)), for windows tw wide at nx positions a row.
+void centre_and_integrate(const cv::Mat& image, float i_mean, int nx, int tw, int ipw,
+                          DirectScratch& scratch) {
+  const int iw = image.cols, ih = image.rows;
+  const std::size_t sw = static_cast<std::size_t>(iw) + 1;
+  scratch.sum.resize(sw * (ih + 1));
+  scratch.sqsum.resize(sw * (ih + 1));
+  std::fill_n(scratch.sum.begin(), sw, 0.0);
+  std::fill_n(scratch.sqsum.begin(), sw, 0.0);
+  // Integral images of the centred image. The window sums read only their columns [0, nx) and
+  // [tw, iw]: between, each row's running sums are carried along but not summed down the rows.
+  // kRows rows at a time: each row's running sums are a chain of dependent adds, so rows side
+  // by side keep several chains in flight (the same adds in the same order per row as one row
+  // at a time).
+  const int gap0 = nx - 1;                  // x in [gap0, gap1): column x + 1 is not read
+  const int gap1 = std::max(gap0, tw - 1);  //
+  constexpr int kRows = 4;
+  for (int y0 = 0; y0 < ih; y0 += kRows) {
+    const int rows = std::min(kRows, ih - y0);
+    const float* src[kRows];
+    float* dst[kRows];
+    double* s_row[kRows];
+    double* q_row[kRows];
+    double s[kRows] = {}, q[kRows] = {};
+    for (int k = 0; k < kRows; ++k) {
+      const int y = y0 + std::min(k, rows - 1);
+      src[k] = image.ptr<float>(y);
+      dst[k] = scratch.image.data() + static_cast<std::size_t>(y) * ipw;
+      s_row[k] = scratch.sum.data() + (y + 1) * sw;
+      q_row[k] = scratch.sqsum.data() + (y + 1) * sw;
+      s_row[k][0] = 0.0;
+      q_row[k][0] = 0.0;
+    }
+    const double* s_up = scratch.sum.data() + y0 * sw;
+    const double* q_up = scratch.sqsum.data() + y0 * sw;
+    // Columns [x0, x1) of the block's rows, summed down the rows when `down` says so.
+    auto block = [&](auto down, int x0, int x1) {
+      for (int x = x0; x < x1; ++x) {
+        // Column x + 1 of the rows above, carried down in registers.
+        double vs = 0, vq = 0;
+        if constexpr (decltype(down)::value) {
+          vs = s_up[x + 1];
+          vq = q_up[x + 1];
+        }
+        for (int k = 0; k < kRows; ++k) {
+          const float d = src[k][x] - i_mean;
+          dst[k][x] = d;
+          s[k] += d;
+          q[k] += static_cast<double>(d) * d;
+          if constexpr (decltype(down)::value) {
+            vs += s[k];
+            vq += q[k];
+            s_row[k][x + 1] = vs;
+            q_row[k][x + 1] = vq;
+          }
+        }
+      }
+    };
+    // The last rows one at a time, the same way.
+    auto row = [&](auto down, int k, int x0, int x1) {
+      const double* su = k == 0 ? s_up : s_row[k - 1];
+      const double* qu = k == 0 ? q_up : q_row[k - 1];
+      for (int x = x0; x < x1; ++x) {
+        const float d = src[k][x] - i_mean;
+        dst[k][x] = d;
+        s[k] += d;
+        q[k] += static_cast<double>(d) * d;
+        if constexpr (decltype(down)::value) {
+          s_row[k][x + 1] = su[x + 1] + s[k];
+          q_row[k][x + 1] = qu[x + 1] + q[k];
+        }
+      }
+    };
+    if (rows == kRows) {
+      block(std::true_type{}, 0, gap0);
+      block(std::false_type{}, gap0, gap1);
+      block(std::true_type{}, gap1, iw);
+    } else {
+      for (int k = 0; k < rows; ++k) {
+        row(std::true_type{}, k, 0, gap0);
+        row(std::false_type{}, k, gap0, gap1);
+        row(std::true_type{}, k, gap1, iw);
+      }
+    }
+    for (int k = 0; k < rows; ++k)
+      std::fill(dst[k] + iw, dst[k] + ipw, 0.f);
+  }
+}
+
 }  // namespace
 
 DirectTemplate::DirectTemplate(const cv::Mat& t) : templ(t) {
@@ -151,60 +243,7 @@ void ccoeff_normed_direct(const cv::Mat& image, const DirectTemplate& prepared, 
   const auto i_mean = static_cast<float>(cv::mean(image)[0]);
   const double t_norm2 = prepared.norm2;
   const std::size_t sw = static_cast<std::size_t>(iw) + 1;
-  scratch.sum.resize(sw * (ih + 1));
-  scratch.sqsum.resize(sw * (ih + 1));
-  std::fill_n(scratch.sum.begin(), sw, 0.0);
-  std::fill_n(scratch.sqsum.begin(), sw, 0.0);
-  // Integral images, kRows rows at a time: each row's running sums are a chain of dependent
-  // adds, so rows side by side keep several chains in flight (the same adds in the same order
-  // per row as one row at a time).
-  constexpr int kRows = 4;
-  for (int y0 = 0; y0 < ih; y0 += kRows) {
-    const int rows = std::min(kRows, ih - y0);
-    const float* src[kRows];
-    float* dst[kRows];
-    double* s_row[kRows];
-    double* q_row[kRows];
-    double s[kRows] = {}, q[kRows] = {};
-    for (int k = 0; k < kRows; ++k) {
-      const int y = y0 + std::min(k, rows - 1);
-      src[k] = image.ptr<float>(y);
-      dst[k] = scratch.image.data() + static_cast<std::size_t>(y) * ipw;
-      s_row[k] = scratch.sum.data() + (y + 1) * sw;
-      q_row[k] = scratch.sqsum.data() + (y + 1) * sw;
-      s_row[k][0] = 0.0;
-      q_row[k][0] = 0.0;
-    }
-    const double* s_up = scratch.sum.data() + y0 * sw;
-    const double* q_up = scratch.sqsum.data() + y0 * sw;
-    if (rows == kRows) {
-      for (int x = 0; x < iw; ++x) {
-        for (int k = 0; k < kRows; ++k) {
-          const float d = src[k][x] - i_mean;
-          dst[k][x] = d;
-          s[k] += d;
-          q[k] += static_cast<double>(d) * d;
-          s_row[k][x + 1] = (k == 0 ? s_up : s_row[k - 1])[x + 1] + s[k];
-          q_row[k][x + 1] = (k == 0 ? q_up : q_row[k - 1])[x + 1] + q[k];
-        }
-      }
-    } else {
-      for (int k = 0; k < rows; ++k) {
-        const double* su = k == 0 ? s_up : s_row[k - 1];
-        const double* qu = k == 0 ? q_up : q_row[k - 1];
-        for (int x = 0; x < iw; ++x) {
-          const float d = src[k][x] - i_mean;
-          dst[k][x] = d;
-          s[k] += d;
-          q[k] += static_cast<double>(d) * d;
-          s_row[k][x + 1] = su[x + 1] + s[k];
-          q_row[k][x + 1] = qu[x + 1] + q[k];
-        }
-      }
-    }
-    for (int k = 0; k < rows; ++k)
-      std::fill(dst[k] + iw, dst[k] + ipw, 0.f);
-  }
+  centre_and_integrate(image, i_mean, nx, tw, ipw, scratch);
   response.create(ny, nx, CV_32F);
   // The positions in row-major order, four at a time (the last group repeats its last one).
   const int positions = nx * ny;
