@@ -306,6 +306,13 @@ bool prior_on(const MatchPrior& p) {
   return p.radius > 0 && p.penalty > 0;
 }
 
+// Throws roiflow::Error unless the prior's radius and penalty are >= 0.
+void check_prior(const MatchPrior& prior) {
+  if (!(prior.radius >= 0 && prior.penalty >= 0)) {
+    throw Error("template search: the prior's radius and penalty must be >= 0");
+  }
+}
+
 // Best full-resolution match of `templ` (already scaled; `prepared` when the caller has it) in
 // `region` of `image`.
 TemplateMatch match_one(const cv::Mat& image, const cv::Mat& templ, const cv::Rect& region,
@@ -379,9 +386,7 @@ TemplateMatch match_template(const cv::Mat& image, const DirectTemplate& templ,
     throw Error("template search: a prepared template needs a float image, got " +
                 cv::typeToString(image.type()));
   }
-  if (!(prior.radius >= 0 && prior.penalty >= 0)) {
-    throw Error("template search: the prior's radius and penalty must be >= 0");
-  }
+  check_prior(prior);
   const cv::Rect region = search & cv::Rect(0, 0, image.cols, image.rows);
   if (region.empty()) return {};
   const TemplateMatch m = match_one(image, templ.templ, region, prior, &templ);
@@ -399,9 +404,7 @@ TemplateMatch match_template(const cv::Mat& image, const cv::Mat& templ, const c
                 cv::typeToString(image.type()) + " and " + cv::typeToString(templ.type()));
   }
   if (params.scales.empty()) throw Error("template search: no scales given");
-  if (!(prior.radius >= 0 && prior.penalty >= 0)) {
-    throw Error("template search: the prior's radius and penalty must be >= 0");
-  }
+  check_prior(prior);
   for (double s : params.scales) {
     if (!(s > 0.0) || !std::isfinite(s)) {
       throw Error("template search: scales must be positive, got " + std::to_string(s));
