@@ -28,7 +28,7 @@ std::string fixed(double value, int decimals) {
   return text;
 }
 
-bool is_file(const fs::path& p) {
+bool regular_file(const fs::path& p) {
   std::error_code ec;
   return fs::is_regular_file(p, ec);
 }
@@ -80,7 +80,7 @@ std::vector<OtbSequence> find_otb_sequences(const std::string& dir,
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) throw Error("benchmark folder '" + dir + "' is not a directory");
   const fs::path root(dir);
-  if (is_file(root / kGroundTruth)) {
+  if (regular_file(root / kGroundTruth)) {
     fs::path named = root;
     if (!named.has_filename()) named = named.parent_path();  // "Car4/" names Car4
     OtbSequence s = read_sequence(root);
@@ -95,7 +95,7 @@ std::vector<OtbSequence> find_otb_sequences(const std::string& dir,
   std::sort(folders.begin(), folders.end());
   std::vector<OtbSequence> sequences;
   for (const fs::path& f : folders) {
-    if (is_file(f / kGroundTruth)) {
+    if (regular_file(f / kGroundTruth)) {
       sequences.push_back(read_sequence(f));
     } else if (skipped) {
       skipped->push_back(f.filename().string());

@@ -31,7 +31,7 @@ int scaled_size(double pixels, double scale) {
 
 // A vehicle pointing right, `size` = length x width: textured body, light stripe, two dark
 // windows, dark wheels at the sides.
-cv::Mat draw_vehicle(cv::Size size, cv::RNG& rng) {
+cv::Mat draw_traffic_vehicle(cv::Size size, cv::RNG& rng) {
   const cv::Scalar body = kBodies[rng.uniform(0, static_cast<int>(std::size(kBodies)))];
   cv::Mat v(size, CV_32FC3, body);
   detail::add_octaves(v, rng, {8, 4, 2}, 7.0);
@@ -114,7 +114,7 @@ TrafficScene::TrafficScene(const TrafficSceneParams& params) : params_(params) {
     const Lane& lane = lanes_[vehicle.lane];
     vehicle.offset = rank[vehicle.lane]++ * lane.cycle / std::max(1, per_lane[vehicle.lane]);
     cv::RNG texture_rng(detail::mix(params_.seed, 1000 + static_cast<std::uint64_t>(v)));
-    cv::Mat texture = draw_vehicle(sizes[v], texture_rng);
+    cv::Mat texture = draw_traffic_vehicle(sizes[v], texture_rng);
     if (lane.direction < 0) cv::flip(texture, texture, 1);
     if (!lane.horizontal) cv::transpose(texture, texture);
     vehicle.alpha =

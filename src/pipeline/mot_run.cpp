@@ -18,11 +18,6 @@
 namespace roiflow::pipeline {
 namespace {
 
-double stage_ms(const nlohmann::ordered_json& stats, const char* stage) {
-  const auto& stages = stats.at("stages");
-  return stages.contains(stage) ? stages.at(stage).at("ms_total").get<double>() : 0.0;
-}
-
 report::ObjectsAnnotation annotation(const stages::MotFrame& f) {
   report::ObjectsAnnotation a;
   a.index = f.index;
@@ -109,7 +104,7 @@ MotRun track_objects(const FrameSource& source, cv::Size size, double fps,
   const nlohmann::ordered_json s = stats.to_json(run.report.wall_s);
   double tracker_ms = 0;
   for (const char* stage : {"pyramid", "background", "global", "plan", "lk", "decide"})
-    tracker_ms += stage_ms(s, stage);
+    tracker_ms += report::stage_ms_total(s, stage);
   const double frames = static_cast<double>(run.report.frames);
   run.summary = {{"mode", "objects"},
                  {"frames", run.report.frames},

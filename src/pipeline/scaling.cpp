@@ -29,11 +29,6 @@ struct Measured {
   std::string input;
 };
 
-double stage_ms(const nlohmann::ordered_json& stats, const char* stage) {
-  const auto& stages = stats.at("stages");
-  return stages.contains(stage) ? stages.at(stage).at("ms_total").get<double>() : 0.0;
-}
-
 std::string fixed(double value, int decimals) {
   char buffer[64];
   std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
@@ -62,7 +57,7 @@ Measured run_once(const ScalingOptions& o, int threads) {
   if (o.mode == ScalingMode::Dense) {
     report = run_dense(frames, o.lk, {}, graph);
     const nlohmann::ordered_json s = stats.to_json(report.wall_s);
-    m.tracker_ms = stage_ms(s, "flow");
+    m.tracker_ms = report::stage_ms_total(s, "flow");
     m.frames = std::max<long long>(0, report.frames - 1);  // pairs
   } else if (o.mode == ScalingMode::Local) {
     MotRunOptions mot;
@@ -83,7 +78,7 @@ Measured run_once(const ScalingOptions& o, int threads) {
     stages::Tracker tracker(params, &tiles);
     report = run_tracking(frames, tracker, {}, graph);
     const nlohmann::ordered_json s = stats.to_json(report.wall_s);
-    m.tracker_ms = stage_ms(s, "pyramid") + stage_ms(s, "track");
+    m.tracker_ms = report::stage_ms_total(s, "pyramid") + report::stage_ms_total(s, "track");
     m.frames = report.frames;
   }
   m.wall_s = report.wall_s;

@@ -41,6 +41,12 @@ double peak_rss_mb() {
   return static_cast<double>(usage.ru_maxrss) / 1024.0;  // Linux reports KiB
 }
 
+double stage_ms_total(const nlohmann::ordered_json& stats, std::string_view stage) {
+  const auto& stages = stats.at("stages");
+  const auto it = stages.find(std::string(stage));
+  return it == stages.end() ? 0.0 : it->at("ms_total").get<double>();
+}
+
 nlohmann::ordered_json stages_json(const std::vector<StageTotal>& stages) {
   nlohmann::ordered_json doc = nlohmann::ordered_json::object();
   for (const StageTotal& s : stages) {

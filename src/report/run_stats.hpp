@@ -35,6 +35,10 @@ struct StageTotal {
 // {"<name>": {"calls", "ms_total", "ms_mean", "fps"}, ...}, the "stages" object of to_json.
 nlohmann::ordered_json stages_json(const std::vector<StageTotal>& stages);
 
+// The total milliseconds of `stage` in a to_json() document (its "stages" object); 0 when the
+// stage never ran.
+double stage_ms_total(const nlohmann::ordered_json& stats, std::string_view stage);
+
 class RunStats {
  public:
   void add(std::string_view stage, double ms);
