@@ -21,7 +21,7 @@
 namespace roiflow::stages {
 namespace {
 
-std::string size_text(cv::Size s) {
+std::string spaced_size_text(cv::Size s) {
   return number_text(s.width) + " x " + number_text(s.height);
 }
 
@@ -341,8 +341,8 @@ void Tracker::Impl::acquire(const TrackerInput& frame, TrackerOutput& out) {
     const cv::Rect2f inside =
         b & cv::Rect2f(0.f, 0.f, static_cast<float>(size.width), static_cast<float>(size.height));
     if (inside.width < 2 || inside.height < 2) {
-      throw Error("tracker: init box " + box_text(b) + " lies outside the " + size_text(size) +
-                  " frame");
+      throw Error("tracker: init box " + box_text(b) + " lies outside the " +
+                  spaced_size_text(size) + " frame");
     }
     detector.set_target(image, b);
     local.start({frame.gray, frame.pyramid}, b);
@@ -579,11 +579,12 @@ TrackerOutput Tracker::Impl::process(const TrackerInput& frame) {
   if (size.empty()) size = frame.gray.size();
   if (frame.gray.size() != size) {
     throw Error("tracker: frame " + number_text(static_cast<double>(frame.index)) + " is " +
-                size_text(frame.gray.size()) + ", the first frame was " + size_text(size));
+                spaced_size_text(frame.gray.size()) + ", the first frame was " +
+                spaced_size_text(size));
   }
   if (!frame.image.empty() && frame.image.size() != size) {
     throw Error("tracker: frame " + number_text(static_cast<double>(frame.index)) + ": image is " +
-                size_text(frame.image.size()) + " but gray is " + size_text(size));
+                spaced_size_text(frame.image.size()) + " but gray is " + spaced_size_text(size));
   }
   if (frame.pyramid &&
       (frame.pyramid->size() != size ||
