@@ -271,11 +271,20 @@ std::vector<ObjectTile> plan_tiles(const TrackSet& state, const Foreground& fg,
     const int step =
         std::max(1, static_cast<int>(std::lround(std::sqrt(area / params.max_points))));
     const bool fg_only = !fg.empty() && !t.known ? fg.moving_share(b) >= 0.15 : false;
+    // Where another object's box overlaps this one (a crossing), the shared pixels follow the
+    // object in front: only this object's own pixels measure it.
+    std::vector<cv::Rect2f> exclude;
+    for (std::size_t j = 0; j < state.tracks.size(); ++j) {
+      const Track& o = state.tracks[j];
+      if (j == i || o.id == 0 || (o.box & b).area() <= 0) continue;
+      exclude.push_back(o.box);
+    }
     const int parts = (region.height + params.tile_rows - 1) / params.tile_rows;
     for (int k = 0; k < parts; ++k) {
       const int y0 = region.y + region.height * k / parts;
       const int y1 = region.y + region.height * (k + 1) / parts;
-      tiles.push_back({i, b, cv::Rect(region.x, y0, region.width, y1 - y0), v, step, fg_only});
+      tiles.push_back(
+          {i, b, cv::Rect(region.x, y0, region.width, y1 - y0), v, step, fg_only, exclude});
     }
   }
   return tiles;
@@ -307,6 +316,10 @@ TileMotion measure_tile(const ObjectTile& tile, const flow::Pyramid& pyr_t,
   std::vector<cv::Point> points;
   for (int y = obj.y + tile.step / 2; y < obj.br().y; y += tile.step) {
     for (int x = obj.x + tile.step / 2; x < obj.br().x; x += tile.step) {
+      const cv::Point2f c(static_cast<float>(x), static_cast<float>(y));
+      if (std::any_of(tile.exclude.begin(), tile.exclude.end(),
+                      [&](const cv::Rect2f& r) { return r.contains(c); }))
+        continue;
       if (tile.foreground_only &&
           fg_t.mask.at<std::uint8_t>(std::min(fg_t.mask.rows - 1, y / fg_t.scale),
                                      std::min(fg_t.mask.cols - 1, x / fg_t.scale)) == 0)
