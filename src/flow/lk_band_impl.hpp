@@ -349,6 +349,10 @@ void run_band(const BandJob& job) {
         if (y >= first[k] && y < last[k]) passes[k].next_row();
       }
     }
+    if (job.rows_done) {
+      const int done = imin(last[K - 1], t - (K - 1) * lag + kBatchRows);
+      if (done > first[K - 1]) job.rows_done(job.done_context, done);
+    }
   }
 }
 

@@ -75,6 +75,10 @@ struct BandJob {
   float* flow = nullptr;
   std::ptrdiff_t flow_stride = 0;
   const FlowRows* rings = nullptr;  // iterations - 1 intermediate results
+  // Non-null: called with e each time the last iteration's rows [begin, e) are all written
+  // (e increasing), so that another thread may read them while the band goes on.
+  void (*rows_done)(void* context, int end) = nullptr;
+  void* done_context = nullptr;
   float* const* scratch = nullptr;  // per iteration: scratch_floats(level) floats, 64-byte aligned
 };
 
