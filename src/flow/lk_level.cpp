@@ -82,7 +82,7 @@ std::size_t LevelScratch::bytes() const {
   }
   for (const Band& b : bands)
     n += b.input.bytes() + b.rings.bytes() + b.rows.bytes();
-  return n;
+  return n + chain_shared.bytes();
 }
 
 int padded_width(int w) {
@@ -299,11 +299,55 @@ void publish_rows(void* context, int end) {
   static_cast<std::atomic<int>*>(context)->store(end, std::memory_order_release);
 }
 
+// The rows of each iteration but the last that the chains share at level L split at `split`
+// (shared_rows); none for an iteration whose share is longer than kMaxSharedRows (many
+// iterations: the lower band's cone grows with each).
+constexpr int kMaxSharedRows = 64;
+
+std::vector<RowSpan> chain_shares(const LevelJob& L, int iterations, int split) {
+  std::vector<RowSpan> spans(std::max(0, iterations - 1));
+  for (int k = 0; k + 1 < iterations; ++k) {
+    const RowSpan r = shared_rows(L, iterations, split, k);
+    if (r.count <= kMaxSharedRows) spans[k] = r;
+  }
+  return spans;
+}
+
+// Where the lower chain hands the shared rows of one level to the upper chain: rows of
+// iteration k at base + (offset[k] + row - spans[k].first) * 2 * wp (u then v, wp floats each);
+// made[k]: the rows of iteration k made so far end there.
+struct SharedRows {
+  std::vector<RowSpan> spans;
+  std::vector<std::size_t> offset;
+  float* base = nullptr;
+  std::ptrdiff_t wp = 0;
+  std::atomic<int>* made = nullptr;
+};
+
+void export_shared(void* context, int k, int row, const float* u, const float* v) {
+  SharedRows& s = *static_cast<SharedRows*>(context);
+  float* d = s.base + (s.offset[k] + static_cast<std::size_t>(row - s.spans[k].first)) * 2 * s.wp;
+  std::copy_n(u, s.wp, d);
+  std::copy_n(v, s.wp, d + s.wp);
+  s.made[k].store(row + 1, std::memory_order_release);
+}
+
+void import_shared(void* context, int k, int row, float* u, float* v) {
+  SharedRows& s = *static_cast<SharedRows*>(context);
+  while (s.made[k].load(std::memory_order_acquire) <= row)
+    std::this_thread::yield();
+  const float* d =
+      s.base + (s.offset[k] + static_cast<std::size_t>(row - s.spans[k].first)) * 2 * s.wp;
+  std::copy_n(d, s.wp, u);
+  std::copy_n(d + s.wp, s.wp, v);
+}
+
 // The iterations of level L over its final rows [begin, end) with band buffers `bp`.
 void run_level_band(const LkKernels& k, const LevelJob& L, const LevelInput& input,
                     const cv::Rect& comp, int iterations, int begin, int end, const BandBuffers& bp,
                     const LevelOutputs& out, CoarserProgress wait = {},
-                    std::atomic<int>* done = nullptr) {
+                    std::atomic<int>* done = nullptr, SharedRows* shared = nullptr,
+                    bool import = false) {
   const int wp = L.wp;
   const int q = ring_rows(L);
   const std::size_t rows_floats = k.scratch_floats(L);
@@ -338,6 +382,16 @@ void run_level_band(const LkKernels& k, const LevelJob& L, const LevelInput& inp
   if (done) {
     job.rows_done = publish_rows;
     job.done_context = done;
+  }
+  // The upper band of a split level takes the shared rows, the lower one hands them over.
+  if (shared) {
+    job.shared = shared->spans.data();
+    if (import) {
+      job.import_row = import_shared;
+    } else {
+      job.export_row = export_shared;
+    }
+    job.share_context = shared;
   }
   k.run_band(job);
 }
@@ -410,19 +464,43 @@ std::vector<int> chain_splits(const LkKernels& k, const std::vector<LevelJob>& j
     double lower_start_prev = 0;
     for (int j = 0; j < n; ++j) {
       const int s = pick[j] * kStripeRows;
-      const double up = work(j, 0, s), low = work(j, s, jobs[j].h);
-      if (j > 0 && s > 0) {
-        const int sp = pick[j - 1] * kStripeRows;
-        const RowSpan in = k.input_rows(jobs[j], levels[j].iterations, 0, s);
-        const int last_in = in.first + in.count - 1;
-        const int need = std::min(coarse_row(j, last_in) + 1, levels[j - 1].p.comp.height - 1);
-        if (need >= sp) {
-          // The first input row that reads below the coarser split.
-          int r = in.first;
-          while (r < last_in && coarse_row(j, r) + 1 < sp)
-            ++r;
-          const double at = upper + up * (r - in.first) / std::max(1, in.count);
-          const double ready = lower_start_prev + work(j - 1, sp, need + 1);
+      const int K = levels[j].iterations;
+      double up = work(j, 0, s);
+      const double low = work(j, s, jobs[j].h);
+      // The upper chain takes the shared rows (solved rows: 9 units each) from the lower one,
+      // which makes them at the start of its band.
+      const std::vector<RowSpan> shares =
+          s > 0 ? chain_shares(jobs[j], K, s) : std::vector<RowSpan>{};
+      int shared_first = s, shared_end = 0;
+      for (const RowSpan& r : shares) {
+        up -= 9.0 * r.count * jobs[j].w;
+        if (r.count > 0) {
+          shared_first = std::min(shared_first, r.first);
+          shared_end = std::max(shared_end, r.first + r.count);
+        }
+      }
+      up = std::max(0.0, up);
+      if (s > 0) {
+        const RowSpan in = k.input_rows(jobs[j], K, 0, s);
+        int last_in = in.first + in.count - 1;
+        if (!shares.empty() && shares[0].count > 0)
+          last_in = std::min(last_in, shares[0].first - 1 + reach_down(jobs[j]));
+        if (j > 0) {
+          const int sp = pick[j - 1] * kStripeRows;
+          const int need = std::min(coarse_row(j, last_in) + 1, levels[j - 1].p.comp.height - 1);
+          if (need >= sp) {
+            // The first input row that reads below the coarser split.
+            int r = in.first;
+            while (r < last_in && coarse_row(j, r) + 1 < sp)
+              ++r;
+            const double at = upper + up * (r - in.first) / std::max(1, in.count);
+            const double ready = lower_start_prev + work(j - 1, sp, need + 1);
+            upper += std::max(0.0, ready - at);
+          }
+        }
+        if (shared_end > 0) {
+          const double at = upper + up * shared_first / s;
+          const double ready = lower + work(j, s, std::min(jobs[j].h, shared_end + 1));
           upper += std::max(0.0, ready - at);
         }
       }
@@ -513,6 +591,31 @@ bool iterate_levels_chained(const std::vector<ChainLevel>& levels, const LevelIn
   }
   const BandBuffers buffers[2] = {reserve_band(scratch.bands[0], most),
                                   reserve_band(scratch.bands[1], most)};
+  // The rows the chains share at each level, with room for them and their progress.
+  std::vector<SharedRows> shared(n);
+  int progress_count = 0;
+  std::vector<std::size_t> level_start(n + 1, 0);
+  for (int j = 0; j < n; ++j) {
+    SharedRows& sh = shared[j];
+    sh.spans = chain_shares(jobs[j], levels[j].iterations, split[j]);
+    sh.wp = jobs[j].wp;
+    std::size_t rows = 0;
+    for (const RowSpan& r : sh.spans) {
+      sh.offset.push_back(rows);
+      rows += static_cast<std::size_t>(r.count);
+    }
+    progress_count += static_cast<int>(sh.spans.size());
+    level_start[j + 1] = level_start[j] + rows * 2 * static_cast<std::size_t>(sh.wp);
+  }
+  const std::unique_ptr<std::atomic<int>[]> made(new std::atomic<int>[std::max(1, progress_count)]);
+  float* const shared_base = scratch.chain_shared.reserve(std::max<std::size_t>(1, level_start[n]));
+  for (int j = 0, p = 0; j < n; ++j) {
+    SharedRows& sh = shared[j];
+    sh.base = shared_base + level_start[j];
+    sh.made = made.get() + p;
+    for (const RowSpan& r : sh.spans)
+      made[p++].store(r.first, std::memory_order_relaxed);
+  }
   // done[j]: the lower chain's last iteration has written level j's rows [split[j], done[j]).
   const std::unique_ptr<std::atomic<int>[]> done(new std::atomic<int>[n]);
   for (int j = 0; j < n; ++j)
@@ -528,7 +631,8 @@ bool iterate_levels_chained(const std::vector<ChainLevel>& levels, const LevelIn
       const CoarserProgress wait =
           c == 1 && j > 0 ? CoarserProgress{&done[j - 1], split[j - 1]} : CoarserProgress{};
       run_level_band(k, jobs[j], inputs[j], l.p.comp, l.iterations, begin, end, buffers[c], out,
-                     wait, c == 0 ? &done[j] : nullptr);
+                     wait, c == 0 ? &done[j] : nullptr, split[j] > 0 ? &shared[j] : nullptr,
+                     c == 1);
     }
   };
   // The lower chain never waits; the upper one waits only on rows of the lower one, which the

@@ -82,6 +82,7 @@ struct LevelScratch {
   // chain_key describes.
   std::vector<std::vector<float>> chain_inv_cx, chain_cy;
   std::vector<int> chain_key, chain_splits;
+  AlignedFloats chain_shared;  // the rows the two chains share
   std::size_t bytes() const;
 };
 
