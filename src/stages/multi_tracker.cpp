@@ -92,6 +92,10 @@ void MultiTrackerParams::validate() const {
   if (min_hits < 1) fail("min_hits must be >= 1, got " + number_text(min_hits));
   if (max_lost < 0) fail("max_lost must be >= 0, got " + number_text(max_lost));
   if (still_frames < 1) fail("still_frames must be >= 1, got " + number_text(still_frames));
+  if (parked_frames < 1) fail("parked_frames must be >= 1, got " + number_text(parked_frames));
+  if (parked_age < 0) fail("parked_age must be >= 0, got " + number_text(parked_age));
+  if (!(parked_motion >= 0) || !std::isfinite(parked_motion))
+    fail("parked_motion must be >= 0, got " + number_text(parked_motion));
   if (!(min_visible > 0 && min_visible <= 1))
     fail("min_visible must be in (0, 1], got " + number_text(min_visible));
   if (min_side < 1) fail("min_side must be >= 1, got " + number_text(min_side));
@@ -355,7 +359,10 @@ LkMeasures measure_lk(TrackSet& s, const std::vector<TileMotion>& motions,
     const double gate = std::max(params.lk_gate, params.lk_gate_share * before.height);
     const cv::Point2f m = good == 0 ? cv::Point2f() : cv::Point2f(median(mx[i]), median(my[i]));
     const bool agrees = good == 0 || t.age < 3 || std::hypot(m.x - v.x, m.y - v.y) <= gate;
-    if (good >= 4 && static_cast<double>(good) >= params.min_inliers * sampled[i] && agrees) {
+    const bool valid = good >= 4 && static_cast<double>(good) >= params.min_inliers * sampled[i];
+    // Its own pixels standing still: a ghost's box grows and moves, its pixels do not.
+    if (valid) t.parked = std::hypot(m.x, m.y) < params.parked_motion ? t.parked + 1 : 0;
+    if (valid && agrees) {
       lk.ok[i] = 1;
       cv::Rect2f& b = lk.box[i];
       b.width = lk.guess[i].width;
@@ -508,7 +515,8 @@ void end_and_confirm(TrackSet& s, cv::Size size, const MultiTrackerParams& param
   kept.reserve(n);
   for (Track& t : s.tracks) {
     const cv::Rect2f inside = t.box & frame_rect(size);
-    const bool end = (t.id == 0 && t.hits < 0) || t.lost > params.max_lost ||
+    const bool ghost = !t.known && t.age < params.parked_age && t.parked >= params.parked_frames;
+    const bool end = ghost || (t.id == 0 && t.hits < 0) || t.lost > params.max_lost ||
                      (!t.known && t.still >= params.still_frames) || t.duplicate >= 3 ||
                      visible_share(t.box, size) < params.min_visible ||
                      inside.width < static_cast<float>(params.min_side) ||

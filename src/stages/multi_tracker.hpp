@@ -32,7 +32,8 @@
 //    no object explains, confirmed after `min_hits` consecutive frames, found on global frames
 //    (every `global_interval` frames and whenever an object is lost). Deaths: lost for
 //    `max_lost` frames, no moving pixels for `still_frames` frames, less than `min_visible` of
-//    the box inside the frame, or a side under `min_side` pixels; an object that duplicates an
+//    the box inside the frame, or a side under `min_side` pixels, or young and its own pixels
+//    standing still for `parked_frames` (a ghost); an object that duplicates an
 //    older one (IoU > 0.7, or 80% of its box inside an older one twice its size: a fragment)
 //    for 3 frames ends too.
 // A box that does not move with moving pixels, collapses or leaves the view is never reported
@@ -90,6 +91,11 @@ struct MultiTrackerParams {
   int min_hits = 3;             // consecutive detections that confirm a birth, >= 1
   int max_lost = 12;            // frames an object coasts without a measurement before it ends
   int still_frames = 15;        // frames without moving pixels before an object ends
+  int parked_frames = 3;        // a young object (age under `parked_age` frames) whose own pixels
+  int parked_age = 10;          // stand still (LK motion under `parked_motion` pixels a frame)
+  double parked_motion = 0.25;  // for this many frames in a row ends: a birth on a ghost (the
+                                // uncovered background behind an object grows as the object
+                                // leaves: its box moves, its pixels do not), >= 1, >= 0, >= 0
   double min_visible = 0.5;     // least share of the box inside the frame, (0, 1]
   int min_side = 8;             // an object whose box is narrower ends, >= 1
   int global_interval = 1;      // frames between global treatments (births), >= 1
@@ -121,6 +127,7 @@ struct Track {
   int lost = 0;    // consecutive frames without a measurement
   int still = 0;   // consecutive frames without moving pixels in the box
   int duplicate = 0;
+  int parked = 0;      // consecutive frames its own pixels stood still (LK)
   bool known = false;  // a known target (no birth, no end for standing still)
   long long age = 0;
 };
