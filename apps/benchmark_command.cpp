@@ -32,6 +32,12 @@ void add_benchmark_command(CLI::App& app, int& /*exit_code*/) {
       ->delimiter(',');
   sub->add_option("--max-frames", run.max_frames, "at most N frames of each sequence (0 = all)")
       ->check(CLI::Range(0LL, 1000000000LL));
+  static std::vector<float> shift{0.f, 0.f};
+  sub->add_option("--init-shift", shift, "every tracker starts from the first box moved DX,DY px")
+      ->type_name("DX,DY")
+      ->expected(2)
+      ->delimiter(',')
+      ->check(CLI::Range(-1000.f, 1000.f));
   add_tracker_options(*sub, run.roiflow, nullptr, "roiflow: ");
   sub->add_flag("--tracks", tracks,
                 "also write every run's track log, OUT/tracks/<sequence>/<tracker>.csv");
@@ -43,6 +49,7 @@ void add_benchmark_command(CLI::App& app, int& /*exit_code*/) {
   sub->callback([] {
     pipeline::BenchmarkOptions o = run;
     o.threads = lk.threads;
+    o.init_shift = {shift.at(0), shift.at(1)};
     o.roiflow.lk = lk_params(lk);
     as_usage([&] { o.roiflow.validate(); });
     pipeline::check_benchmark_out(out);
