@@ -15,7 +15,9 @@
 //  - plan_tiles(state at t) -> the LK tiles for frame t+1: one per object region (the object's
 //    box at t plus a margin), regions taller than `tile_rows` split into row tiles.
 //  - measure_tile(tile, pyramids of t and t+1, foreground of t) -> the tile's object pixels that
-//    pass the forward-backward check and their motion. Thread-safe; one task per tile.
+//    pass the forward-backward check and their motion; pixels inside another object's
+//    overlapping box are not the object's own (in a crossing they move with the one in front)
+//    and are left out. Thread-safe; one task per tile.
 //  - MotionDetector::observe and detect_objects (stages/motion_detector.hpp): the background
 //    refresh and the global treatment (moving objects of the frame).
 //  - decide(state at t, the frame's tile motions, foreground, detections) -> state at t+1: per
@@ -140,6 +142,9 @@ struct ObjectTile {
   cv::Point2f velocity;          // predicted motion, the LK seed
   int step = 1;                  // grid step of the sampled object pixels
   bool foreground_only = false;  // sample only moving pixels of frame t
+  // Other objects' boxes in frame t that overlap this one: their pixels are not sampled (where
+  // two objects cross, the shared pixels follow whichever is in front).
+  std::vector<cv::Rect2f> exclude;
 };
 
 struct TileMotion {

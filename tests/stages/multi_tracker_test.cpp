@@ -275,6 +275,24 @@ TEST(MultiTracker, KeepsIdsThroughACrossing) {
   EXPECT_NE(*c[0].ids.begin(), *c[1].ids.begin());
 }
 
+TEST(MultiTracker, KeepsEachObjectThroughAPerpendicularCrossing) {
+  // A tall object driving up and a wide one driving left across it, in front of it: while they
+  // overlap, the shared pixels move with the one in front. Each object is measured by its own
+  // pixels only (not those inside the other's box), so the tall one's box is not dragged
+  // sideways with the wide one and both keep their ids.
+  MotScene scene({320, 240},
+                 {{{150, 150, 24, 50}, {0, -1.5f}, 8}, {{250, 100, 60, 22}, {-2.5f, 0}, 8}});
+  const auto found = run(scene, 100);
+  const std::vector<Coverage> c = coverage(scene, found, 25);
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    EXPECT_EQ(c[i].ids.size(), 1u) << "object " << i;
+    EXPECT_GT(c[i].covered, 0.8) << "object " << i;
+  }
+  ASSERT_FALSE(c[0].ids.empty());
+  ASSERT_FALSE(c[1].ids.empty());
+  EXPECT_NE(*c[0].ids.begin(), *c[1].ids.begin());
+}
+
 TEST(MultiTracker, ReportsNothingOnAStaticSceneAndEndsObjectsThatLeave) {
   MotScene still({200, 150}, {});
   for (const auto& f : run(still, 40))
