@@ -233,7 +233,7 @@ class TwoLanes final : public Executor {
 };
 
 TEST(DenseLkTest, TwoChainsOfBandsGiveTheSerialResultBitForBit) {
-  for (const cv::Size size : {cv::Size(320, 240), cv::Size(131, 203), cv::Size(64, 40)}) {
+  for (const cv::Size size : {cv::Size(192, 160), cv::Size(131, 203), cv::Size(64, 40)}) {
     const cv::Mat a = texture(size, 21);
     cv::Mat b;
     const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0.05, 2.3, -0.04, 1, -1.6);
@@ -248,7 +248,8 @@ TEST(DenseLkTest, TwoChainsOfBandsGiveTheSerialResultBitForBit) {
              {TwoLanes::Order::Threads, TwoLanes::Order::InOrder, TwoLanes::Order::Reversed}) {
           const TwoLanes lanes(order);
           DenseLK lk(c.params, &lanes);
-          for (int call = 0; call < 2; ++call) {  // the second reuses the splits
+          // The second call reuses the splits (once is enough for the one-thread orders).
+          for (int call = 0; call < (order == TwoLanes::Order::Threads ? 2 : 1); ++call) {
             const FlowResult two = lk.calc(a, b, options);
             ASSERT_EQ(two.flow.size(), serial.flow.size());
             EXPECT_EQ(cv::norm(two.flow, serial.flow, cv::NORM_INF), 0.0)
