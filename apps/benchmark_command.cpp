@@ -28,21 +28,21 @@ void add_benchmark_command(CLI::App& app, int& /*exit_code*/) {
       ->delimiter(',')
       ->check([](const std::string& t) { return stages::box_tracker_check(t); })
       ->capture_default_str();
-  sub->add_option("--sequences", run.sequences, "only these sequences (folder names)")
-      ->delimiter(',');
+  sub->add_option("--sequences", run.sequences, "only these sequences (folders)")->delimiter(',');
   sub->add_option("--max-frames", run.max_frames, "at most N frames of each sequence (0 = all)")
       ->check(CLI::Range(0LL, 1000000000LL));
+  static std::pair<float, float> shift;
+  sub->add_option("--init-shift", shift, "start from the first box moved DX,DY px")->delimiter(',');
   add_tracker_options(*sub, run.roiflow, nullptr, "roiflow: ");
-  sub->add_flag("--tracks", tracks,
-                "also write every run's track log, OUT/tracks/<sequence>/<tracker>.csv");
+  sub->add_flag("--tracks", tracks, "also write the track logs, OUT/tracks/<seq>/<tracker>.csv");
   sub->add_flag("!--no-progress", progress, "no line per finished sequence on stderr");
   lk.threads = pipeline::default_threads();
   add_lk_options(*sub, lk);
-  sub->get_option("--threads")
-      ->description("sequences at once (each tracker call runs on one thread, CPU-timed)");
+  sub->get_option("--threads")->description("sequences at once (each tracker call: one thread)");
   sub->callback([] {
     pipeline::BenchmarkOptions o = run;
     o.threads = lk.threads;
+    o.init_shift = {shift.first, shift.second};
     o.roiflow.lk = lk_params(lk);
     as_usage([&] { o.roiflow.validate(); });
     pipeline::check_benchmark_out(out);

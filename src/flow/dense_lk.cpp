@@ -190,6 +190,37 @@ cv::Mat view(const cv::Mat& plane, cv::Size size) {
   return plane(cv::Rect(cv::Point(), size));
 }
 
+// The LK levels as two chains of row bands (detail::iterate_levels_chained) when `exec` has
+// exactly two threads, LK ends at level 0 and every level only iterates (no coarse search, no
+// fusion, no median between levels); false, computing nothing, otherwise.
+bool chain_levels(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkParams& params,
+                  const FlowOptions& options, const LevelPlan& plan, cv::Size size, bool direct,
+                  FlowResult& result, const Executor& exec, DenseLK::Workspace& ws) {
+  const int levels = plan.top;
+  const std::vector<cv::Rect>& comp = plan.comp;
+  bool chained = exec.concurrency() == 2 && plan.finest == 0 && levels >= 2;
+  for (int l = 0; l < levels && chained; ++l) {
+    chained = !detail::seeds_level(params, l, levels, options) &&
+              (l == plan.finest || params.level_median <= 1);
+  }
+  if (!chained) return false;
+  std::vector<detail::ChainLevel> chain(levels);
+  for (int l = levels - 1; l >= 0; --l) {
+    detail::ChainLevel& cl = chain[levels - 1 - l];
+    cl.p = level_problem(pyr_t.levels[l], pyr_t1.levels[l], comp[l], params);
+    cl.iterations = params.iterations_at(l, plan.finest);
+    cl.u = &ws.u[l];
+    cl.v = &ws.v[l];
+    if (l == 0) {
+      cl.confidence = direct ? &result.confidence : &ws.confidence;
+      cl.flow = direct ? &result.flow : nullptr;
+    }
+  }
+  const LevelInput input = coarsest_input(options, levels - 1, level_size(size, levels - 1),
+                                          comp[levels - 1], ws.init_u, ws.init_v);
+  return detail::iterate_levels_chained(chain, input, exec, ws.scratch);
+}
+
 // Dense flow from pyramids with `ws`'s buffers (params already validated).
 void flow_from_pyramids(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkParams& params,
                         FlowResult& result, const FlowOptions& options, const Executor* executor,
@@ -215,7 +246,19 @@ void flow_from_pyramids(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkPar
   // and no median follows.
   const bool direct =
       plan.finest == 0 && params.final_median == 0 && region.size() == comp[0].size();
-  for (int l = levels - 1; l >= 0; --l) {
+  // With two threads, levels that only iterate run as two chains of bands (no barrier between
+  // levels); the flow is the same.
+  const bool chained =
+      chain_levels(pyr_t, pyr_t1, params, options, plan, size, direct, result, exec, ws);
+  if (chained && direct) {
+    result.region = region;
+    return;
+  }
+  if (chained) {
+    cv::Mat u = view(ws.u[0], comp[0].size()), v = view(ws.v[0], comp[0].size());
+    median_filter(u, v, params.final_median, exec);
+  }
+  for (int l = levels - 1; l >= 0 && !chained; --l) {
     const cv::Rect& c = comp[l];
     if (l == 0 && plan.finest > 0) break;  // level 0 is upsampled into the result below
     if (l < plan.finest) {                 // below the finest level the flow is only upsampled

@@ -332,9 +332,28 @@ void run_band(const BandJob& job) {
   const RowSpan span = input_rows(L, K, job.begin, job.end);
   int filled_to = span.first;
   const int input_end = span.first + span.count;
+  // Iteration k's rows from import_from[k] come from import_row; those in [export_from[k],
+  // export_to[k]) go to export_row as they are made.
+  int import_from[kMaxIterations], export_from[kMaxIterations], export_to[kMaxIterations];
+  for (int k = 0; k < K; ++k) {
+    import_from[k] = last[k];
+    export_from[k] = export_to[k] = 0;
+    if (k + 1 < K && job.shared && job.shared[k].count > 0) {
+      const RowSpan& s = job.shared[k];
+      if (job.import_row) import_from[k] = imax(first[k], imin(last[k], s.first));
+      if (job.export_row) {
+        export_from[k] = s.first;
+        export_to[k] = s.first + s.count;
+      }
+    }
+  }
   for (int t = first[0]; t < t_end; t += kBatchRows) {
     for (int k = 0; k < K; ++k) {
       for (int y = t - k * lag; y < t - k * lag + kBatchRows; ++y) {
+        if (y >= import_from[k] && y < last[k]) {
+          job.import_row(job.share_context, k, y, row_u(job.rings[k], y), row_v(job.rings[k], y));
+          continue;
+        }
         if (k == 0 && job.fill_input && y >= first[0] && y < last[0]) {
           // Iteration 0's row y reads input rows up to y + reach_down.
           const int need = imin(input_end, y + reach_down(L) + 1);
@@ -346,8 +365,17 @@ void run_band(const BandJob& job) {
           if (k + 1 < K) passes[k].solve_from(first[k + 1] - reach_up(L));
           passes[k].start(y);
         }
-        if (y >= first[k] && y < last[k]) passes[k].next_row();
+        if (y >= first[k] && y < last[k]) {
+          passes[k].next_row();
+          if (y >= export_from[k] && y < export_to[k]) {
+            job.export_row(job.share_context, k, y, row_u(job.rings[k], y), row_v(job.rings[k], y));
+          }
+        }
       }
+    }
+    if (job.rows_done) {
+      const int done = imin(last[K - 1], t - (K - 1) * lag + kBatchRows);
+      if (done > first[K - 1]) job.rows_done(job.done_context, done);
     }
   }
 }

@@ -1,4 +1,5 @@
 // Run-time choice of the dense LK kernels (lk_kernels.hpp).
+#include <algorithm>
 #include <atomic>
 #include <cstdlib>
 #include <cstring>
@@ -41,6 +42,23 @@ int reach_up(const LevelJob& level) {
 
 int reach_down(const LevelJob& level) {
   return level.hi + 1;
+}
+
+RowSpan shared_rows(const LevelJob& level, int iterations, int split, int k) {
+  if (split <= 0 || k < 0 || k + 1 >= iterations) return {};
+  // The band starting at `split` starts iteration i on the stripe before the rows iteration
+  // i + 1 reads (lk_band_impl.hpp's iteration_rows) and solves iteration k from the first row
+  // iteration k + 1 reads; the band ending at `split` runs iteration k reach_down rows further
+  // down for each later iteration.
+  int next = split;  // where the lower band starts iteration i + 1
+  for (int i = iterations - 2; i > k; --i) {
+    const int v = next - reach_up(level);
+    const int s = level.stripe;
+    next = std::max(0, v >= 0 ? v / s * s : -((-v + s - 1) / s) * s);
+  }
+  const int first = std::max(0, next - reach_up(level));
+  const int last = std::min(level.h, split + (iterations - 1 - k) * reach_down(level));
+  return {first, std::max(0, last - first)};
 }
 
 int available_lk_kernels(const LkKernels** out, int capacity) {

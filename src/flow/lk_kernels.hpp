@@ -53,6 +53,16 @@ struct LevelJob {
 int reach_up(const LevelJob& level);
 int reach_down(const LevelJob& level);
 
+// Rows [first, first + count) of a level (what each use says).
+struct RowSpan {
+  int first = 0, count = 0;
+};
+
+// Rows of iteration k (< iterations - 1) that the bands on both sides of row `split` compute
+// alike: from the first row the band starting at `split` solves in iteration k to the last row
+// the band ending there computes in it. Empty when split is 0.
+RowSpan shared_rows(const LevelJob& level, int iterations, int split, int k);
+
 // The iterations of one level over the final rows [begin, end), each earlier iteration over the
 // rows the next one reads (rounded out to a stripe start, so that every row is computed exactly
 // as in a single pass over the level: the result never depends on how rows are split).
@@ -75,12 +85,19 @@ struct BandJob {
   float* flow = nullptr;
   std::ptrdiff_t flow_stride = 0;
   const FlowRows* rings = nullptr;  // iterations - 1 intermediate results
+  // Non-null: called with e each time the last iteration's rows [begin, e) are all written
+  // (e increasing), so that another thread may read them while the band goes on.
+  void (*rows_done)(void* context, int end) = nullptr;
+  void* done_context = nullptr;
+  // Non-null: per iteration k < iterations - 1, rows of iteration k this band shares with a
+  // band beside it (shared_rows; count 0: none). The band ending at `end` takes its shared rows
+  // from import_row (instead of computing them: into u, v, wp floats each); the band starting
+  // at `begin` hands each shared row it computes to export_row.
+  const RowSpan* shared = nullptr;
+  void (*import_row)(void* context, int k, int row, float* u, float* v) = nullptr;
+  void (*export_row)(void* context, int k, int row, const float* u, const float* v) = nullptr;
+  void* share_context = nullptr;
   float* const* scratch = nullptr;  // per iteration: scratch_floats(level) floats, 64-byte aligned
-};
-
-// Rows [first, first + count) of the first iteration's rows needed for [begin, end).
-struct RowSpan {
-  int first = 0, count = 0;
 };
 
 struct LkKernels {
@@ -88,7 +105,7 @@ struct LkKernels {
   int lanes;         // floats per vector
   std::size_t (*scratch_floats)(const LevelJob& level);
   void (*run_band)(const BandJob& job);
-  // The rows iteration 0 reads for final rows [begin, end).
+  // The rows iteration 0 reads for final rows [begin, end) (all of them: without shared rows).
   RowSpan (*input_rows)(const LevelJob& level, int iterations, int begin, int end);
   // The work of run_band for final rows [begin, end): the rows all iterations compute, each
   // weighted by what it costs (a row solved 9, a row that only enters the window 5).

@@ -78,6 +78,11 @@ struct LevelScratch {
   };
   std::vector<Band> bands;
   std::vector<float> inv_cx, cy;
+  // iterate_levels_chained's: each level's window weights and the splits, for the geometry
+  // chain_key describes.
+  std::vector<std::vector<float>> chain_inv_cx, chain_cy;
+  std::vector<int> chain_key, chain_splits;
+  AlignedFloats chain_shared;  // the rows the two chains share
   std::size_t bytes() const;
 };
 
@@ -93,6 +98,28 @@ int padded_width(int w);
 void iterate_level(const LevelProblem& p, const LevelInput& input, cv::Mat& u, cv::Mat& v,
                    cv::Mat* confidence, int iterations, const Executor& executor,
                    LevelScratch& scratch, cv::Mat* flow = nullptr);
+
+// One level of iterate_levels_chained: its problem, iterations and outputs (u, v, confidence,
+// flow as iterate_level takes them).
+struct ChainLevel {
+  LevelProblem p;
+  int iterations = 1;
+  cv::Mat* u = nullptr;
+  cv::Mat* v = nullptr;
+  cv::Mat* confidence = nullptr;
+  cv::Mat* flow = nullptr;
+};
+
+// iterate_level on each of `levels` in turn (coarse to fine: the first starts from `input`,
+// every later one from the level before it, upsampled as LevelInput::coarser does), on two
+// chains of row bands without a barrier between levels: the lower chain takes the lower rows of
+// every level and reads only rows it wrote, the upper chain takes the upper rows and waits, row
+// by row, for the lower chain's rows it reads on the coarser level (the first few of them, made
+// early). Two chunks of one executor region, so a thread runs a whole chain and the chains'
+// work, not each level's, is balanced; the result is iterate_level's to the last bit. Returns
+// false, computing nothing, when no split fits (levels too small).
+bool iterate_levels_chained(const std::vector<ChainLevel>& levels, const LevelInput& input,
+                            const Executor& executor, LevelScratch& scratch);
 
 // Flow component of the coarser level (origin `src_origin` in its level) resampled onto
 // rectangle `dst` of the finer level and doubled; blocks of rows on `executor` when given (the

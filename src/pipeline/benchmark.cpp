@@ -66,7 +66,7 @@ struct Job {
 };
 
 // Opens the sequence's frames and checks them against its ground truth.
-void open_job(Job& job, long long max_frames) {
+void open_job(Job& job, long long max_frames, cv::Point2f shift) {
   const eval::OtbSequence& s = job.sequence;
   stages::VideoSourceParams params;
   params.max_frames = max_frames;
@@ -80,11 +80,17 @@ void open_job(Job& job, long long max_frames) {
   }
   const cv::Size size = job.source->size();
   const cv::Rect2f first = s.truth.front();
-  const cv::Rect2f inside =
-      first & cv::Rect2f(0.f, 0.f, static_cast<float>(size.width), static_cast<float>(size.height));
+  const cv::Rect2f frame(0.f, 0.f, static_cast<float>(size.width), static_cast<float>(size.height));
+  const cv::Rect2f inside = first & frame;
   if (!(inside.width >= 2 && inside.height >= 2)) {
     throw Error(s.name + ": the first ground-truth box " + box_text(first) + " lies outside the " +
                 std::to_string(size.width) + "x" + std::to_string(size.height) + " frame");
+  }
+  const cv::Rect2f start = (first + shift) & frame;
+  if (!(start.width >= 2 && start.height >= 2)) {
+    throw Error(s.name + ": the first ground-truth box " + box_text(first) +
+                " shifted by --init-shift leaves the " + std::to_string(size.width) + "x" +
+                std::to_string(size.height) + " frame");
   }
 }
 
@@ -101,9 +107,10 @@ void run_job(Job& job, const BenchmarkOptions& options) {
     const cv::Mat bgr = any_opencv ? stages::bgr_picture(*frame) : cv::Mat();
     for (std::size_t t = 0; t < trackers.size(); ++t) {
       const double start = thread_cpu_s();
-      const stages::BoxUpdate u = frames == 0
-                                      ? trackers[t]->start(*frame, bgr, job.sequence.truth.front())
-                                      : trackers[t]->next(*frame, bgr);
+      const stages::BoxUpdate u =
+          frames == 0
+              ? trackers[t]->start(*frame, bgr, job.sequence.truth.front() + options.init_shift)
+              : trackers[t]->next(*frame, bgr);
       const double spent = thread_cpu_s() - start;
       job.runs[t].cpu_s += spent;
       job.runs[t].ms.push_back(1000.0 * spent);
@@ -127,6 +134,9 @@ BenchmarkResult run_benchmark(const BenchmarkOptions& options) {
                 std::to_string(kMaxThreads));
   }
   if (options.max_frames < 0) throw Error("benchmark max_frames must be >= 0");
+  if (!(std::abs(options.init_shift.x) <= 1000 && std::abs(options.init_shift.y) <= 1000)) {
+    throw Error("benchmark init shift must be finite and at most 1000 pixels each way");
+  }
   check_trackers(options.trackers);
   options.roiflow.validate();
 
@@ -147,7 +157,7 @@ BenchmarkResult run_benchmark(const BenchmarkOptions& options) {
     jobs.push_back({std::move(s), std::nullopt, {}});
   }
   for (Job& job : jobs)
-    open_job(job, options.max_frames);
+    open_job(job, options.max_frames, options.init_shift);
 
   std::mutex report_mutex;
   {

@@ -27,6 +27,9 @@ struct BenchmarkOptions {
   int threads = 1;                     // sequences run at once, 1..256
   long long max_frames = 0;            // at most this many frames of each sequence; 0 = all
   stages::TrackerParams roiflow;       // roiflow's settings (init is set per sequence)
+  // Every tracker starts from the first ground-truth box moved by this many pixels (scoring
+  // still uses the true boxes): OTB's spatial-robustness check, |each| <= 1000.
+  cv::Point2f init_shift;
   // Called after each sequence, from the thread that ran it (one call at a time), with e.g.
   // "DragonBaby: 113 frames, 5 trackers".
   std::function<void(const std::string&)> on_sequence;

@@ -5,7 +5,6 @@
 #define EIGEN_DONT_VECTORIZE
 #include <Eigen/Dense>
 #include <algorithm>
-#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -14,7 +13,6 @@
 #include "core/assignment.hpp"
 #include "core/error.hpp"
 #include "core/text.hpp"
-#include "core/text_file.hpp"
 #include "stages/select_impl.hpp"
 
 namespace roiflow::stages {
@@ -66,49 +64,6 @@ float median(std::vector<float> v) {
 
 }  // namespace
 
-std::vector<KnownTarget> parse_known_targets(std::string_view text, const std::string& name) {
-  std::vector<KnownTarget> out;
-  for_each_line(text, [&](long long number, std::string_view line) {
-    const std::string where = name + ":" + std::to_string(number) + ": ";
-    if (line.empty() || line.front() == '#') return;
-    std::vector<std::string_view> f;
-    for (std::size_t start = 0;;) {
-      const std::size_t comma = line.find(',', start);
-      f.push_back(line.substr(start, comma - start));
-      if (comma == std::string_view::npos) break;
-      start = comma + 1;
-    }
-    if (f.size() != 5) {
-      throw Error(where + "expected 5 fields id,x,y,w,h, got " + std::to_string(f.size()));
-    }
-    KnownTarget k;
-    const auto [id_end, id_ec] = std::from_chars(f[0].data(), f[0].data() + f[0].size(), k.id);
-    if (id_ec != std::errc() || id_end != f[0].data() + f[0].size() || k.id < 1)
-      throw Error(where + "id " + quoted_excerpt(f[0]) + " is not an id (1, 2, ...)");
-    double v[4];
-    const char* names[] = {"x", "y", "w", "h"};
-    for (int i = 0; i < 4; ++i) {
-      const std::string_view s = f[static_cast<std::size_t>(i) + 1];
-      const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v[i]);
-      if (ec != std::errc() || end != s.data() + s.size() || !std::isfinite(v[i]) ||
-          std::abs(v[i]) > 1e7)
-        throw Error(where + names[i] + " " + quoted_excerpt(s) + " is not a finite number");
-    }
-    if (!(v[2] > 0 && v[3] > 0)) throw Error(where + "the box needs a positive width and height");
-    for (const KnownTarget& other : out)
-      if (other.id == k.id) throw Error(where + "id " + std::to_string(k.id) + " given twice");
-    k.box = cv::Rect2f(static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2]),
-                       static_cast<float>(v[3]));
-    out.push_back(k);
-  });
-  if (out.empty()) throw Error(name + ": no target (expected id,x,y,w,h lines)");
-  return out;
-}
-
-std::vector<KnownTarget> read_known_targets(const std::string& path) {
-  return parse_known_targets(read_text_file(path, "targets file"), path);
-}
-
 void MultiTrackerParams::validate() const {
   auto fail = [](const std::string& what) { throw Error("multi-object tracker: " + what); };
   detector.validate();
@@ -137,6 +92,10 @@ void MultiTrackerParams::validate() const {
   if (min_hits < 1) fail("min_hits must be >= 1, got " + number_text(min_hits));
   if (max_lost < 0) fail("max_lost must be >= 0, got " + number_text(max_lost));
   if (still_frames < 1) fail("still_frames must be >= 1, got " + number_text(still_frames));
+  if (parked_frames < 1) fail("parked_frames must be >= 1, got " + number_text(parked_frames));
+  if (parked_age < 0) fail("parked_age must be >= 0, got " + number_text(parked_age));
+  if (!(parked_motion >= 0) || !std::isfinite(parked_motion))
+    fail("parked_motion must be >= 0, got " + number_text(parked_motion));
   if (!(min_visible > 0 && min_visible <= 1))
     fail("min_visible must be in (0, 1], got " + number_text(min_visible));
   if (min_side < 1) fail("min_side must be >= 1, got " + number_text(min_side));
@@ -271,11 +230,20 @@ std::vector<ObjectTile> plan_tiles(const TrackSet& state, const Foreground& fg,
     const int step =
         std::max(1, static_cast<int>(std::lround(std::sqrt(area / params.max_points))));
     const bool fg_only = !fg.empty() && !t.known ? fg.moving_share(b) >= 0.15 : false;
+    // Where another object's box overlaps this one (a crossing), the shared pixels follow the
+    // object in front: only this object's own pixels measure it.
+    std::vector<cv::Rect2f> exclude;
+    for (std::size_t j = 0; j < state.tracks.size(); ++j) {
+      const Track& o = state.tracks[j];
+      if (j == i || o.id == 0 || (o.box & b).area() <= 0) continue;
+      exclude.push_back(o.box);
+    }
     const int parts = (region.height + params.tile_rows - 1) / params.tile_rows;
     for (int k = 0; k < parts; ++k) {
       const int y0 = region.y + region.height * k / parts;
       const int y1 = region.y + region.height * (k + 1) / parts;
-      tiles.push_back({i, b, cv::Rect(region.x, y0, region.width, y1 - y0), v, step, fg_only});
+      tiles.push_back(
+          {i, b, cv::Rect(region.x, y0, region.width, y1 - y0), v, step, fg_only, exclude});
     }
   }
   return tiles;
@@ -307,6 +275,10 @@ TileMotion measure_tile(const ObjectTile& tile, const flow::Pyramid& pyr_t,
   std::vector<cv::Point> points;
   for (int y = obj.y + tile.step / 2; y < obj.br().y; y += tile.step) {
     for (int x = obj.x + tile.step / 2; x < obj.br().x; x += tile.step) {
+      const cv::Point2f c(static_cast<float>(x), static_cast<float>(y));
+      if (std::any_of(tile.exclude.begin(), tile.exclude.end(),
+                      [&](const cv::Rect2f& r) { return r.contains(c); }))
+        continue;
       if (tile.foreground_only &&
           fg_t.mask.at<std::uint8_t>(std::min(fg_t.mask.rows - 1, y / fg_t.scale),
                                      std::min(fg_t.mask.cols - 1, x / fg_t.scale)) == 0)
@@ -387,7 +359,10 @@ LkMeasures measure_lk(TrackSet& s, const std::vector<TileMotion>& motions,
     const double gate = std::max(params.lk_gate, params.lk_gate_share * before.height);
     const cv::Point2f m = good == 0 ? cv::Point2f() : cv::Point2f(median(mx[i]), median(my[i]));
     const bool agrees = good == 0 || t.age < 3 || std::hypot(m.x - v.x, m.y - v.y) <= gate;
-    if (good >= 4 && static_cast<double>(good) >= params.min_inliers * sampled[i] && agrees) {
+    const bool valid = good >= 4 && static_cast<double>(good) >= params.min_inliers * sampled[i];
+    // Its own pixels standing still: a ghost's box grows and moves, its pixels do not.
+    if (valid) t.parked = std::hypot(m.x, m.y) < params.parked_motion ? t.parked + 1 : 0;
+    if (valid && agrees) {
       lk.ok[i] = 1;
       cv::Rect2f& b = lk.box[i];
       b.width = lk.guess[i].width;
@@ -540,7 +515,8 @@ void end_and_confirm(TrackSet& s, cv::Size size, const MultiTrackerParams& param
   kept.reserve(n);
   for (Track& t : s.tracks) {
     const cv::Rect2f inside = t.box & frame_rect(size);
-    const bool end = (t.id == 0 && t.hits < 0) || t.lost > params.max_lost ||
+    const bool ghost = !t.known && t.age < params.parked_age && t.parked >= params.parked_frames;
+    const bool end = ghost || (t.id == 0 && t.hits < 0) || t.lost > params.max_lost ||
                      (!t.known && t.still >= params.still_frames) || t.duplicate >= 3 ||
                      visible_share(t.box, size) < params.min_visible ||
                      inside.width < static_cast<float>(params.min_side) ||

@@ -15,7 +15,9 @@
 //  - plan_tiles(state at t) -> the LK tiles for frame t+1: one per object region (the object's
 //    box at t plus a margin), regions taller than `tile_rows` split into row tiles.
 //  - measure_tile(tile, pyramids of t and t+1, foreground of t) -> the tile's object pixels that
-//    pass the forward-backward check and their motion. Thread-safe; one task per tile.
+//    pass the forward-backward check and their motion; pixels inside another object's
+//    overlapping box are not the object's own (in a crossing they move with the one in front)
+//    and are left out. Thread-safe; one task per tile.
 //  - MotionDetector::observe and detect_objects (stages/motion_detector.hpp): the background
 //    refresh and the global treatment (moving objects of the frame).
 //  - decide(state at t, the frame's tile motions, foreground, detections) -> state at t+1: per
@@ -30,7 +32,8 @@
 //    no object explains, confirmed after `min_hits` consecutive frames, found on global frames
 //    (every `global_interval` frames and whenever an object is lost). Deaths: lost for
 //    `max_lost` frames, no moving pixels for `still_frames` frames, less than `min_visible` of
-//    the box inside the frame, or a side under `min_side` pixels; an object that duplicates an
+//    the box inside the frame, or a side under `min_side` pixels, or young and its own pixels
+//    standing still for `parked_frames` (a ghost); an object that duplicates an
 //    older one (IoU > 0.7, or 80% of its box inside an older one twice its size: a fragment)
 //    for 3 frames ends too.
 // A box that does not move with moving pixels, collapses or leaves the view is never reported
@@ -88,6 +91,11 @@ struct MultiTrackerParams {
   int min_hits = 3;             // consecutive detections that confirm a birth, >= 1
   int max_lost = 12;            // frames an object coasts without a measurement before it ends
   int still_frames = 15;        // frames without moving pixels before an object ends
+  int parked_frames = 3;        // a young object (age under `parked_age` frames) whose own pixels
+  int parked_age = 10;          // stand still (LK motion under `parked_motion` pixels a frame)
+  double parked_motion = 0.25;  // for this many frames in a row ends: a birth on a ghost (the
+                                // uncovered background behind an object grows as the object
+                                // leaves: its box moves, its pixels do not), >= 1, >= 0, >= 0
   double min_visible = 0.5;     // least share of the box inside the frame, (0, 1]
   int min_side = 8;             // an object whose box is narrower ends, >= 1
   int global_interval = 1;      // frames between global treatments (births), >= 1
@@ -119,6 +127,7 @@ struct Track {
   int lost = 0;    // consecutive frames without a measurement
   int still = 0;   // consecutive frames without moving pixels in the box
   int duplicate = 0;
+  int parked = 0;      // consecutive frames its own pixels stood still (LK)
   bool known = false;  // a known target (no birth, no end for standing still)
   long long age = 0;
 };
@@ -140,6 +149,9 @@ struct ObjectTile {
   cv::Point2f velocity;          // predicted motion, the LK seed
   int step = 1;                  // grid step of the sampled object pixels
   bool foreground_only = false;  // sample only moving pixels of frame t
+  // Other objects' boxes in frame t that overlap this one: their pixels are not sampled (where
+  // two objects cross, the shared pixels follow whichever is in front).
+  std::vector<cv::Rect2f> exclude;
 };
 
 struct TileMotion {

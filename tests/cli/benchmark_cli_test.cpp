@@ -105,6 +105,14 @@ TEST_F(BenchmarkCliTest, BadInputFailsWithOneLineAndNoOutput) {
       {{"benchmark", path("set"), "--out", path("a_file")}, 1, "is not a directory"},
       {{"benchmark", path("set")}, 2, "--out"},
       {{"benchmark", path("set"), "--out", out, "--threads", "0"}, 2, "--threads"},
+      {{"benchmark", path("set"), "--out", out, "--init-shift", "1"}, 2, "--init-shift"},
+      {{"benchmark", path("set"), "--out", out, "--init-shift", "1,x"}, 2, "--init-shift"},
+      {{"benchmark", path("set"), "--out", out, "--init-shift", "1,1e9"},
+       1,
+       "init shift must be finite and at most 1000 pixels"},
+      {{"benchmark", path("set"), "--out", out, "--init-shift=-900,0"},
+       1,
+       "shifted by --init-shift leaves the"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.expected);

@@ -5,12 +5,16 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <functional>
 #include <limits>
 #include <opencv2/imgproc.hpp>
 #include <string>
+#include <thread>
+#include <utility>
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/executor.hpp"
 #include "lk_configurations.hpp"
 #include "test_util.hpp"
 
@@ -194,6 +198,68 @@ TEST(DenseLkTest, RegionOutsideTheFrameThrows) {
     FlowOptions options;
     options.region = region;
     EXPECT_THROW(dense_flow(frame0, frame1, LkParams::paper(), options), Error) << region;
+  }
+}
+
+// Executors of two lanes that run the chunks of a region on two threads at once, or one after
+// the other in either order: the two-chain schedule of the levels (iterate_levels_chained) gives
+// the serial result bit for bit under each, and never waits forever.
+class TwoLanes final : public Executor {
+ public:
+  enum class Order { Threads, InOrder, Reversed };
+  explicit TwoLanes(Order order) : order_(order) {}
+  void for_range(int begin, int end, int grain,
+                 const std::function<void(int, int)>& body) const override {
+    const int step = std::max(1, grain);
+    std::vector<std::pair<int, int>> chunks;
+    for (int b = begin; b < end; b += step)
+      chunks.emplace_back(b, std::min(end, b + step));
+    if (order_ == Order::Reversed) std::reverse(chunks.begin(), chunks.end());
+    if (order_ != Order::Threads) {
+      for (const auto& [b, e] : chunks)
+        body(b, e);
+      return;
+    }
+    std::vector<std::thread> threads;
+    for (const auto& [b, e] : chunks)
+      threads.emplace_back([&body, b = b, e = e] { body(b, e); });
+    for (std::thread& t : threads)
+      t.join();
+  }
+  int concurrency() const override { return 2; }
+
+ private:
+  Order order_;
+};
+
+TEST(DenseLkTest, TwoChainsOfBandsGiveTheSerialResultBitForBit) {
+  for (const cv::Size size : {cv::Size(192, 160), cv::Size(131, 203), cv::Size(64, 40)}) {
+    const cv::Mat a = texture(size, 21);
+    cv::Mat b;
+    const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0.05, 2.3, -0.04, 1, -1.6);
+    cv::warpAffine(a, b, shift, size, cv::INTER_LINEAR, cv::BORDER_REFLECT);
+    for (const test::NamedParams& c : test::lk_configurations()) {
+      for (const cv::Rect region :
+           {cv::Rect(), cv::Rect(10, 30, size.width / 2, size.height / 2)}) {
+        FlowOptions options;
+        options.region = region;
+        const FlowResult serial = dense_flow(a, b, c.params, options);
+        for (const auto order :
+             {TwoLanes::Order::Threads, TwoLanes::Order::InOrder, TwoLanes::Order::Reversed}) {
+          const TwoLanes lanes(order);
+          DenseLK lk(c.params, &lanes);
+          // The second call reuses the splits (once is enough for the one-thread orders).
+          for (int call = 0; call < (order == TwoLanes::Order::Threads ? 2 : 1); ++call) {
+            const FlowResult two = lk.calc(a, b, options);
+            ASSERT_EQ(two.flow.size(), serial.flow.size());
+            EXPECT_EQ(cv::norm(two.flow, serial.flow, cv::NORM_INF), 0.0)
+                << c.name << " " << size << " " << region << " " << static_cast<int>(order);
+            EXPECT_EQ(cv::norm(two.confidence, serial.confidence, cv::NORM_INF), 0.0)
+                << c.name << " " << size << " " << region << " " << static_cast<int>(order);
+          }
+        }
+      }
+    }
   }
 }
 

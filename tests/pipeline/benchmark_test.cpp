@@ -162,6 +162,29 @@ TEST_F(BenchmarkTest, WritesTheTablesAndPlots) {
   }
 }
 
+// --init-shift: every tracker starts from the first box moved, and is scored against the true
+// boxes (so the first frame's IoU is below 1).
+TEST_F(BenchmarkTest, InitShiftMovesEveryTrackersStartBox) {
+  const cv::Rect2f first = eval::find_otb_sequences(path("set")).front().truth.front();
+  BenchmarkOptions o = options({"roiflow", "mosse"});
+  o.sequences = {"otb"};
+  o.max_frames = 3;
+  const BenchmarkResult plain = run_benchmark(o);
+  o.init_shift = {3.f, -2.f};
+  const BenchmarkResult shifted = run_benchmark(o);
+  ASSERT_EQ(shifted.runs.size(), 2u);
+  const cv::Rect2f roiflow_start = shifted.runs[0].boxes.front();
+  EXPECT_NEAR(roiflow_start.x, first.x + 3.f, 1e-4);
+  EXPECT_NEAR(roiflow_start.y, first.y - 2.f, 1e-4);
+  EXPECT_NEAR(roiflow_start.width, first.width, 1e-4);
+  EXPECT_NEAR(roiflow_start.height, first.height, 1e-4);
+  // MOSSE rounds its box to whole pixels.
+  EXPECT_NEAR(shifted.runs[1].boxes.front().x, first.x + 3.f, 1.0);
+  EXPECT_NEAR(shifted.runs[1].boxes.front().y, first.y - 2.f, 1.0);
+  EXPECT_NEAR(plain.runs[0].boxes.front().x, first.x, 1e-4);
+  EXPECT_LT(shifted.rows[0].mean_iou, plain.rows[0].mean_iou);
+}
+
 TEST_F(BenchmarkTest, BadInputFailsBeforeAnyTrackerRuns) {
   const auto fails = [&](BenchmarkOptions o, const std::string& expected) {
     SCOPED_TRACE(expected);
@@ -183,6 +206,12 @@ TEST_F(BenchmarkTest, BadInputFailsBeforeAnyTrackerRuns) {
   o = options({"roiflow"});
   o.dir = path("nowhere");
   fails(o, "not a directory");
+  o = options({"roiflow"});
+  o.init_shift = {0.f, std::nanf("")};
+  fails(o, "init shift must be finite");
+  o = options({"roiflow"});
+  o.init_shift = {400.f, 0.f};  // the frames are 160 wide
+  fails(o, "shifted by --init-shift leaves the 160x120 frame");
 
   // One box too many for the frames.
   std::ofstream(path("set/otb/groundtruth_rect.txt"), std::ios::app) << "1 2 3 4\n";

@@ -275,6 +275,24 @@ TEST(MultiTracker, KeepsIdsThroughACrossing) {
   EXPECT_NE(*c[0].ids.begin(), *c[1].ids.begin());
 }
 
+TEST(MultiTracker, KeepsEachObjectThroughAPerpendicularCrossing) {
+  // A tall object driving up and a wide one driving left across it, in front of it: while they
+  // overlap, the shared pixels move with the one in front. Each object is measured by its own
+  // pixels only (not those inside the other's box), so the tall one's box is not dragged
+  // sideways with the wide one and both keep their ids.
+  MotScene scene({320, 240},
+                 {{{150, 150, 24, 50}, {0, -1.5f}, 8}, {{250, 100, 60, 22}, {-2.5f, 0}, 8}});
+  const auto found = run(scene, 100);
+  const std::vector<Coverage> c = coverage(scene, found, 25);
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    EXPECT_EQ(c[i].ids.size(), 1u) << "object " << i;
+    EXPECT_GT(c[i].covered, 0.8) << "object " << i;
+  }
+  ASSERT_FALSE(c[0].ids.empty());
+  ASSERT_FALSE(c[1].ids.empty());
+  EXPECT_NE(*c[0].ids.begin(), *c[1].ids.begin());
+}
+
 TEST(MultiTracker, ReportsNothingOnAStaticSceneAndEndsObjectsThatLeave) {
   MotScene still({200, 150}, {});
   for (const auto& f : run(still, 40))
@@ -426,6 +444,44 @@ TEST(Decide, InAMergeTheSizeSpeedFades) {
   EXPECT_LT(s.tracks[0].box.width, 40 + 2 / (1 - p.lk_size_decay) + 1);
 }
 
+TEST(Decide, AYoungObjectWhosePixelsStandStillIsAGhost) {
+  // Three objects whose boxes hold moving pixels: LK finds the pixels of the first two standing
+  // still, those of the third moving. The young one standing still (a birth on the uncovered
+  // background behind an object) ends after parked_frames; the older one standing still (it may
+  // have stopped) and the young one moving stay.
+  MultiTrackerParams p;
+  stages::Foreground fg;
+  fg.scale = 1;
+  fg.frame_size = {320, 240};
+  fg.mask = cv::Mat(240, 320, CV_8U, cv::Scalar(255));
+  cv::Mat ones(240, 320, CV_8U, cv::Scalar(1));
+  cv::integral(ones, fg.integral, CV_32S);
+  stages::TrackSet s =
+      tracks_of({{20, 20, 40, 36}, {120, 20, 40, 36}, {220, 120, 40, 36}});  // ids 1, 2, 3
+  s.tracks[0].age = 2;
+  s.tracks[1].age = 40;
+  s.tracks[2].age = 2;
+  s.tracks[2].filter = stages::BoxFilter::start(s.tracks[2].box, {1, 0});
+  std::vector<stages::TileMotion> m(3);
+  for (std::size_t i = 0; i < 3; ++i) {
+    m[i].track = i;
+    m[i].sampled = 40;
+    m[i].moves.assign(40, i == 2 ? cv::Point2f(1, 0) : cv::Point2f(0, 0));
+  }
+  for (int k = 1; k <= p.parked_frames; ++k) {
+    s = stages::decide(s, 10 + k, s.size, m, fg, {}, p);
+    std::set<long long> ids;
+    for (const stages::Track& t : s.tracks)
+      ids.insert(t.id);
+    EXPECT_EQ(ids.count(1), k < p.parked_frames ? 1u : 0u) << k;
+    EXPECT_EQ(ids.count(2), 1u) << k;
+    EXPECT_EQ(ids.count(3), 1u) << k;
+    for (std::size_t i = 0; i < s.tracks.size(); ++i)  // the motions' indices follow the set
+      m[i].track = i,
+      m[i].moves.assign(40, s.tracks[i].id == 3 ? cv::Point2f(1, 0) : cv::Point2f(0, 0));
+  }
+}
+
 TEST(MultiTracker, FollowsKnownTargetsWithTheirIds) {
   MotScene scene({240, 160}, {{{20, 40, 24, 40}, {2, 0}, 0}, {{180, 90, 24, 40}, {-2, 0}, 0}});
   MultiTrackerParams p;
@@ -473,6 +529,12 @@ TEST(MultiTrackerParams, RejectsBadValues) {
   p = {};
   p.detector.ghost_frames = -1;
   EXPECT_NE(test::error_message([&] { p.validate(); }).find("ghost_frames"), std::string::npos);
+  p = {};
+  p.parked_frames = 0;
+  EXPECT_NE(test::error_message([&] { p.validate(); }).find("parked_frames"), std::string::npos);
+  p = {};
+  p.parked_motion = -1;
+  EXPECT_NE(test::error_message([&] { p.validate(); }).find("parked_motion"), std::string::npos);
   p = {};
   p.known = {{1, {0, 0, 10, 10}}, {1, {5, 5, 10, 10}}};
   EXPECT_NE(test::error_message([&] { p.validate(); }).find("twice"), std::string::npos);
