@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
@@ -18,6 +19,7 @@
 #include <iterator>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/error.hpp"
@@ -53,6 +55,16 @@ class TempDirTest : public ::testing::Test {
 
   std::filesystem::path dir_;
 };
+
+// [begin, end) cut into chunks of `grain` (at least 1) rows, in order: what an Executor's
+// for_range hands its body.
+inline std::vector<std::pair<int, int>> chunks_of(int begin, int end, int grain) {
+  const int step = std::max(1, grain);
+  std::vector<std::pair<int, int>> chunks;
+  for (int b = begin; b < end; b += step)
+    chunks.emplace_back(b, std::min(end, b + step));
+  return chunks;
+}
 
 inline std::string read_text(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);

@@ -210,10 +210,7 @@ class TwoLanes final : public Executor {
   explicit TwoLanes(Order order) : order_(order) {}
   void for_range(int begin, int end, int grain,
                  const std::function<void(int, int)>& body) const override {
-    const int step = std::max(1, grain);
-    std::vector<std::pair<int, int>> chunks;
-    for (int b = begin; b < end; b += step)
-      chunks.emplace_back(b, std::min(end, b + step));
+    std::vector<std::pair<int, int>> chunks = test::chunks_of(begin, end, grain);
     if (order_ == Order::Reversed) std::reverse(chunks.begin(), chunks.end());
     if (order_ != Order::Threads) {
       for (const auto& [b, e] : chunks)

@@ -163,10 +163,7 @@ class ReversedChunks final : public Executor {
  public:
   void for_range(int begin, int end, int grain,
                  const std::function<void(int, int)>& body) const override {
-    const int step = std::max(1, grain);
-    std::vector<std::pair<int, int>> chunks;
-    for (int b = begin; b < end; b += step)
-      chunks.emplace_back(b, std::min(end, b + step));
+    std::vector<std::pair<int, int>> chunks = test::chunks_of(begin, end, grain);
     for (auto it = chunks.rbegin(); it != chunks.rend(); ++it)
       it->first < it->second ? body(it->first, it->second) : void();
     calls += static_cast<int>(chunks.size());

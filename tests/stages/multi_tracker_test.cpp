@@ -369,6 +369,16 @@ TEST(Decide, EndsAFragmentInsideAnOlderObject) {
 }
 
 // A track set of confirmed objects `boxes` (ids 1, 2, ...), decided up to frame 10.
+// A 320x240 foreground whose every pixel moves (mask and changed-pixel integral all set).
+stages::Foreground moving_everywhere() {
+  stages::Foreground fg;
+  fg.scale = 1;
+  fg.frame_size = {320, 240};
+  fg.mask = cv::Mat(240, 320, CV_8U, cv::Scalar(255));
+  cv::integral(cv::Mat(240, 320, CV_8U, cv::Scalar(1)), fg.integral, CV_32S);
+  return fg;
+}
+
 stages::TrackSet tracks_of(const std::vector<cv::Rect2f>& boxes) {
   stages::TrackSet s;
   s.frame = 10;
@@ -418,12 +428,7 @@ TEST(Decide, InAMergeTheSizeSpeedFades) {
   // its neighbour): LK alone measures it, which gives no size, so the size's speed fades by
   // lk_size_decay a frame instead of growing the box on and on.
   MultiTrackerParams p;
-  stages::Foreground fg;
-  fg.scale = 1;
-  fg.frame_size = {320, 240};
-  fg.mask = cv::Mat(240, 320, CV_8U, cv::Scalar(255));
-  cv::Mat ones(240, 320, CV_8U, cv::Scalar(1));
-  cv::integral(ones, fg.integral, CV_32S);
+  const stages::Foreground fg = moving_everywhere();
   const cv::Rect2f left(100, 100, 40, 36), right(142, 100, 40, 36), both(100, 100, 82, 36);
   stages::TrackSet s = tracks_of({left, right});
   s.tracks[0].filter.x[6] = 2;  // width growing 2 px a frame
@@ -450,12 +455,7 @@ TEST(Decide, AYoungObjectWhosePixelsStandStillIsAGhost) {
   // background behind an object) ends after parked_frames; the older one standing still (it may
   // have stopped) and the young one moving stay.
   MultiTrackerParams p;
-  stages::Foreground fg;
-  fg.scale = 1;
-  fg.frame_size = {320, 240};
-  fg.mask = cv::Mat(240, 320, CV_8U, cv::Scalar(255));
-  cv::Mat ones(240, 320, CV_8U, cv::Scalar(1));
-  cv::integral(ones, fg.integral, CV_32S);
+  const stages::Foreground fg = moving_everywhere();
   stages::TrackSet s =
       tracks_of({{20, 20, 40, 36}, {120, 20, 40, 36}, {220, 120, 40, 36}});  // ids 1, 2, 3
   s.tracks[0].age = 2;
