@@ -33,6 +33,18 @@ inline std::string size_text(cv::Size size) {
   return fmt::format("{}x{}", size.width, size.height);
 }
 
+// The fields of `text` between `sep` characters, as views into it: "a,,b" gives "a", "", "b";
+// an empty text gives one empty field.
+inline std::vector<std::string_view> split_view(std::string_view text, char sep) {
+  std::vector<std::string_view> fields;
+  for (std::size_t start = 0;;) {
+    const std::size_t at = text.find(sep, start);
+    fields.push_back(text.substr(start, at - start));
+    if (at == std::string_view::npos) return fields;
+    start = at + 1;
+  }
+}
+
 // "a, b, c" (with the default separator).
 inline std::string joined(const std::vector<std::string>& items, std::string_view sep = ", ") {
   std::string list;

@@ -39,12 +39,8 @@ std::string_view trim(std::string_view s) {
 std::vector<std::string_view> split_fields(std::string_view line) {
   std::vector<std::string_view> fields;
   if (line.find(',') != std::string_view::npos) {
-    for (std::size_t start = 0;;) {
-      const std::size_t comma = line.find(',', start);
-      fields.push_back(trim(line.substr(start, comma - start)));
-      if (comma == std::string_view::npos) break;
-      start = comma + 1;
-    }
+    for (const std::string_view field : split_view(line, ','))
+      fields.push_back(trim(field));
     return fields;
   }
   for (std::size_t start = 0; start < line.size();) {

@@ -5,6 +5,7 @@
 #include <system_error>
 
 #include "core/error.hpp"
+#include "core/text.hpp"
 #include "eval/image_io.hpp"
 
 namespace roiflow::eval {
@@ -34,13 +35,7 @@ SyntheticInput parse_synthetic_input(const std::string& input) {
   };
   if (!is_synthetic_input(input)) throw bad("it does not start with synthetic:");
   std::string_view spec = std::string_view(input).substr(kSyntheticInputPrefix.size());
-  std::vector<std::string_view> fields;
-  for (std::size_t start = 0;;) {
-    const std::size_t colon = spec.find(':', start);
-    fields.push_back(spec.substr(start, colon - start));
-    if (colon == std::string_view::npos) break;
-    start = colon + 1;
-  }
+  const std::vector<std::string_view> fields = split_view(spec, ':');
   if (fields.size() > 3) throw bad("too many fields");
   SyntheticInput out;
   const auto frames = number(fields[0]);

@@ -37,13 +37,7 @@ double rounded(double value, int decimals) {
 using detail::LineError;
 
 std::vector<std::string_view> split_commas(std::string_view line) {
-  std::vector<std::string_view> fields;
-  for (std::size_t start = 0;;) {
-    const std::size_t comma = line.find(',', start);
-    fields.push_back(line.substr(start, comma - start));
-    if (comma == std::string_view::npos) return fields;
-    start = comma + 1;
-  }
+  return split_view(line, ',');
 }
 
 double parse_number(std::string_view field, const char* name, const LineError& error) {

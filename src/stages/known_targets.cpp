@@ -15,13 +15,7 @@ std::vector<KnownTarget> parse_known_targets(std::string_view text, const std::s
   for_each_line(text, [&](long long number, std::string_view line) {
     const std::string where = name + ":" + std::to_string(number) + ": ";
     if (line.empty() || line.front() == '#') return;
-    std::vector<std::string_view> f;
-    for (std::size_t start = 0;;) {
-      const std::size_t comma = line.find(',', start);
-      f.push_back(line.substr(start, comma - start));
-      if (comma == std::string_view::npos) break;
-      start = comma + 1;
-    }
+    const std::vector<std::string_view> f = split_view(line, ',');
     if (f.size() != 5) {
       throw Error(where + "expected 5 fields id,x,y,w,h, got " + std::to_string(f.size()));
     }
