@@ -76,6 +76,11 @@ void LocalTrackerParams::validate() const {
   check_range("coast_decay", coast_decay, 0, 1);
   check_range("max_reach", max_reach, 2, 100);
   check_range("lost_prior", lost_prior, 0, 1);
+  check_range("scale_check_interval", scale_check_interval, 0, 1000);
+  if (!(scale_check_margin > 0 && scale_check_margin <= 1)) {
+    throw Error("local tracker: scale_check_margin must be in (0, 1], got " +
+                number_text(scale_check_margin));
+  }
 }
 
 const char* to_string(LostReason reason) {
@@ -336,8 +341,13 @@ LocalResult LocalTracker::Impl::track(const LocalFrame& in) {
   // A box must never collapse to nothing.
   scale = std::clamp(scale, 1.0 / kMaxScaleChange, kMaxScaleChange);
   if (std::min(box.width, box.height) * scale < 2.0) scale = 1.0;
+  cv::Rect2f next = box_at(c, box.size() * static_cast<float>(scale));
+  // Held by the flow: now and then, the first look checks the size over a wide range.
+  if (!by_look && check_size(in, next)) {
+    scale = static_cast<double>(next.width) / static_cast<double>(box.width);
+    c = centre(next);
+  }
   const cv::Point2f measured = c - centre(box);
-  const cv::Rect2f next = box_at(c, box.size() * static_cast<float>(scale));
   const LostReason state = check_state(r, measured, next);
   if (state != LostReason::Found) return lose(r, state, predicted_box, in);
 
@@ -389,6 +399,7 @@ void LocalTracker::start(const LocalFrame& frame, const cv::Rect2f& box) {
   s.memory.clear();
   s.memory_sizes.clear();
   s.since_memory = 0;
+  s.wide_sizes.clear();
 }
 
 void LocalTracker::restart(const LocalFrame& frame, const cv::Rect2f& box) {

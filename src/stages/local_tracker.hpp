@@ -91,7 +91,15 @@ struct LocalTrackerParams {
                              // (docs/BENCHMARK.md)
   double max_reach = 8;      // while lost, the appearance search around the coasting box widens
                              // from 2 to this many times `search`, 2..100
-  void validate() const;     // throws roiflow::Error naming the bad value
+  int scale_check_interval = 10;    // every this many held frames the first look is matched at
+                                    // 17 sizes 5 % apart (0.68-1.48 of the box), each searched over
+                                    // the whole window: a size 10 % or more from the box's that
+                                    // beats the box's own by scale_check_margin, on two frames in a
+                                    // row, takes the box half-way to it (the flow's scale measures
+                                    // the box's content, background included, and the step's own
+                                    // search sees only +-6 %); 0 = off, 0..1000
+  double scale_check_margin = 0.1;  // NCC by which that size must beat the box's, (0, 1]
+  void validate() const;            // throws roiflow::Error naming the bad value
 };
 
 // One frame for the local treatment.

@@ -189,6 +189,10 @@ struct LocalTracker::Impl {
   std::vector<cv::Mat> memory;  // earlier confident looks (long-term memory), oldest first
   std::vector<ScaledTemplates> memory_sizes;
   int since_memory = 0;
+  // The wide size check (check_size): the first look at sizes far from the box's.
+  ScaledTemplates wide_sizes;
+  int since_size_check = 0;
+  int size_pending = 0;  // the direction (+1 larger, -1 smaller) the last check asked for, 0 none
   // Self-awareness (local_tracker_checks.cpp).
   bool lost = false;    // the last step left the target lost: the box coasts
   int lost_frames = 0;  // frames lost in a row
@@ -247,6 +251,8 @@ struct LocalTracker::Impl {
     lost = false;
     lost_frames = 0;
     moving = 0;
+    since_size_check = 0;
+    size_pending = 0;
   }
 
   // `r` grown to the coarsest level's pixel grid and to at least kMinLevelSide pixels there
@@ -379,7 +385,8 @@ struct LocalTracker::Impl {
   }
 
   Appearance match(const cv::Mat& appearance, ScaledTemplates& sizes, const flow::Pyramid& pyr,
-                   cv::Point origin, const cv::Rect2f& b, double reach) const;
+                   cv::Point origin, const cv::Rect2f& b, double reach, int steps = -1) const;
+  bool check_size(const LocalFrame& in, cv::Rect2f& b);
   cv::Point2f measure_motion(const LocalResult& r, double& scale);
   LocalResult track(const LocalFrame& frame);
 };

@@ -11,12 +11,14 @@
 
 namespace roiflow::stages {
 
-// The template matched at 2 * scale_steps + 1 scales around the box's size, on the finest level
-// where the object's shorter side is still at least match_side: NCC's cost grows with the
-// template's area, and a few dozen pixels across are plenty to place and size a whole object.
+// The template matched at 2 * scale_steps + 1 scales around the box's size (2 * steps + 1 when
+// `steps` >= 0), on the finest level where the object's shorter side is still at least
+// match_side: NCC's cost grows with the template's area, and a few dozen pixels across are plenty
+// to place and size a whole object.
 Appearance LocalTracker::Impl::match(const cv::Mat& appearance, ScaledTemplates& sizes,
                                      const flow::Pyramid& pyr, cv::Point origin,
-                                     const cv::Rect2f& b, double reach) const {
+                                     const cv::Rect2f& b, double reach, int steps) const {
+  const int scale_steps = steps >= 0 ? steps : params.scale_steps;
   const double shorter = std::min(b.width, b.height);
   const int level = coarsest_level_with(shorter, params.match_side, pyr.num_levels());
   const double f = 1.0 / (1 << level);
@@ -35,8 +37,8 @@ Appearance LocalTracker::Impl::match(const cv::Mat& appearance, ScaledTemplates&
   // The measured scale searches the whole window; the other scales only a few pixels around its
   // best position (a few percent of size change moves the best position by less than a pixel),
   // which keeps the cost of the scales near that of one.
-  const int n = 2 * params.scale_steps + 1;
-  const int middle = params.scale_steps;
+  const int n = 2 * scale_steps + 1;
+  const int middle = scale_steps;
   std::vector<TemplateMatch> found(n);
   std::vector<double> log_scale(n);
   cv::Rect middle_window;
@@ -47,7 +49,7 @@ Appearance LocalTracker::Impl::match(const cv::Mat& appearance, ScaledTemplates&
   if (reach > 1.0) prior = {ck, radius, params.lost_prior};
   for (int k = 0; k < n; ++k) {
     const int j = k == 0 ? middle : (k <= middle ? k - 1 : k);
-    const double ratio = std::pow(1.0 + params.scale_step, j - params.scale_steps);
+    const double ratio = std::pow(1.0 + params.scale_step, j - scale_steps);
     const double scale = box_scale * ratio * f;
     const bool near_middle = j != middle && found[middle].score > -1;
     const cv::Point2f at = near_middle ? centre(found[middle].box) : ck;
@@ -175,6 +177,67 @@ Appearance LocalTracker::Impl::look(const LocalFrame& in, const cv::Rect2f& b, d
     if (o.score > a.score) a = o;
   }
   return a;
+}
+
+// The first look at 17 sizes 5 % apart around `b` (0.68-1.48 of it; none whose shorter side
+// falls below match_side, where a part of the target matches as well as the whole), each
+// searched over the whole window, every scale_check_interval held frames. The step's own
+// search sees only a few percent around the measured size, and the flow's scale measures the
+// box's content: a box that took in background around the target grows with the background's
+// motion, and a recent look cut from it then matches it at its wrong size. A size 10 % or more
+// from the box's, not at the range's ends, that beats the box's own by scale_check_margin (and
+// is a confident match) on two frames in a row moves the box half-way to it, in log size and in
+// position. Returns whether it did.
+bool LocalTracker::Impl::check_size(const LocalFrame& in, cv::Rect2f& b) {
+  if (params.scale_check_interval == 0 || ++since_size_check < params.scale_check_interval) {
+    return false;
+  }
+  since_size_check = 0;
+  constexpr int kSteps = 8;
+  constexpr double kStep = 1.05, kFar = 1.1;
+  const double shorter = std::min(b.width, b.height);
+  const int lowest = std::max(
+      -kSteps,
+      static_cast<int>(std::ceil(std::log(params.match_side / shorter) / std::log(kStep))));
+  if (lowest >= 0) {
+    size_pending = 0;
+    return false;
+  }
+  const cv::Point2f c = centre(b);
+  cover(in,
+        match_need(templ, box_at(c, b.size() * static_cast<float>(std::pow(kStep, kSteps))), 1.0));
+  const cv::Point origin = next_part.rect.tl();
+  double own = -1;
+  Appearance best;
+  double best_ratio = 1;
+  int best_j = 0;
+  for (int j = lowest; j <= kSteps; ++j) {
+    const double k = std::pow(kStep, j);
+    const Appearance a = match(templ, wide_sizes, view_next, origin,
+                               box_at(c, b.size() * static_cast<float>(k)), 1.0, 0);
+    if (j == 0) own = a.score;
+    if (a.score > best.score) {
+      best = a;
+      best_ratio = k * a.size_ratio;
+      best_j = j;
+    }
+  }
+  int dir = 0;
+  if (own > -1 && best.score >= params.confident_appearance && best_j > lowest && best_j < kSteps &&
+      best.score >= own + params.scale_check_margin &&
+      (best_ratio >= kFar || best_ratio <= 1 / kFar)) {
+    dir = best_ratio > 1 ? 1 : -1;
+  }
+  // A new direction is checked again on the next frame before it is taken.
+  if (dir == 0 || dir != size_pending) {
+    size_pending = dir;
+    if (dir != 0) since_size_check = params.scale_check_interval - 1;
+    return false;
+  }
+  size_pending = 0;
+  const float k = static_cast<float>(std::sqrt(best_ratio));
+  b = box_at(0.5f * (c + best.centre), b.size() * k);
+  return true;
 }
 
 // The appearance memory follows the target slowly and only from confident frames: the recent
