@@ -55,6 +55,50 @@ struct WarpGeometry {
   int dx1, dy1;  // offsets of the right and lower neighbours (0 on a one-pixel side)
 };
 
+// The four taps of a vector whose samples lie in one row or two adjacent ones, less than 31
+// columns apart, by two loads of 32 columns per row, permutes and, over two rows, a per-lane
+// choice (a gather loads lane by lane): false where they do not, or without two-vector permutes.
+template <class S>
+ROIFLOW_INLINE bool near_taps(const WarpGeometry& g, typename S::I ix, typename S::I iy,
+                              typename S::F& p00, typename S::F& p01, typename S::F& p10,
+                              typename S::F& p11) {
+  if constexpr (!S::kPermute2) {
+    return false;
+  } else {
+    using F = typename S::F;
+    using I = typename S::I;
+    using M = typename S::M;
+    constexpr int N = S::N;
+    // A little left of lane 0's column: the flow may pull later lanes left of it.
+    const std::int32_t x = imax(0, imin(S::first(ix) - 4, g.ixmax + 2 - 2 * N));
+    const I rel = S::subi(ix, S::seti(x));
+    if (x + 2 * N > g.ixmax + 2 || !S::all(S::below(rel, 2 * N - 1))) return false;
+    // The upper row: lane 0's, or the one above it (flow near zero rounds either way).
+    const std::int32_t y0 = S::first(iy);
+    const std::int32_t y = S::any(S::eqi(iy, S::seti(y0 - 1))) ? y0 - 1 : y0;
+    const M upper = S::eqi(iy, S::seti(y));
+    const bool one_row = S::all(upper);
+    if (!one_row && !S::all(S::either(upper, S::eqi(iy, S::seti(y + 1))))) return false;
+    const I rel1 = S::addi(rel, S::seti(1));
+    const float* r0 = g.base + static_cast<Idx>(y) * g.step + x;
+    const float* r1 = r0 + g.step;
+    const F a0 = S::load(r0), a1 = S::load(r0 + N), b0 = S::load(r1), b1 = S::load(r1 + N);
+    p00 = S::permute2(a0, a1, rel);
+    p01 = S::permute2(a0, a1, rel1);
+    p10 = S::permute2(b0, b1, rel);
+    p11 = S::permute2(b0, b1, rel1);
+    if (one_row) return true;
+    // Lanes on row y + 1 (which is then at most the last but one) take rows y + 1 and y + 2.
+    const float* r2 = r1 + g.step;
+    const F c0 = S::load(r2), c1 = S::load(r2 + N);
+    p00 = S::select(upper, p00, p10);
+    p01 = S::select(upper, p01, p11);
+    p10 = S::select(upper, p10, S::permute2(c0, c1, rel));
+    p11 = S::select(upper, p11, S::permute2(c0, c1, rel1));
+    return true;
+  }
+}
+
 template <class S>
 ROIFLOW_INLINE void warp_block(const WarpGeometry& g, float fx0, float fy, const float* u,
                                const float* v, const float* i0, float* m, float* d,
@@ -79,7 +123,7 @@ ROIFLOW_INLINE void warp_block(const WarpGeometry& g, float fx0, float fy, const
     p01 = S::load(p + 1);
     p10 = S::load(p + g.step);
     p11 = S::load(p + g.step + 1);
-  } else {
+  } else if (!may_load_rows || !near_taps<S>(g, ix, iy, p00, p01, p10, p11)) {
     p00 = S::gather(g.base, idx);
     p01 = S::gather(g.base, S::addi(idx, S::seti(g.dx1)));
     p10 = S::gather(g.base, S::addi(idx, S::seti(g.dy1)));
@@ -174,16 +218,27 @@ ROIFLOW_INLINE const float* at_factor(const float* row, int x, int f) {
 // at +1/2). Each warped row's column pairs are formed once (it serves two derivative-grid rows):
 // Dm = m[x+1] - m[x], Sm = m[x] + m[x+1], Sd, Su, Sv likewise (interleaved like the ring). Flow
 // rows: column w holds column w - 1, so x + 1 is the replicated neighbour at the last column.
+// Column x + 1 comes from the next vector in registers (aligned loads only: a load one column
+// off spans two vectors the warp has just stored, and waits for both to leave the store queue).
 void hs_pairs(int x0, int x1, const float* m, const float* d, const float* u, const float* v,
               float* pairs) {
   using S = Native;
+  using F = S::F;
+  if (x0 >= x1) return;
+  F m0 = S::load(m + x0), d0 = S::load(d + x0), u0 = S::load(u + x0), v0 = S::load(v + x0);
   for (int x = x0; x < x1; x += S::N) {
-    const S::F m0 = S::load(m + x), m1 = S::load(m + x + 1);
+    const int n = x + S::N;
+    const F m2 = S::load(m + n), d2 = S::load(d + n), u2 = S::load(u + n), v2 = S::load(v + n);
+    const F m1 = S::next1(m0, m2);
     S::store(at(pairs, x, 0), S::sub(m1, m0));
     S::store(at(pairs, x, 1), S::add(m0, m1));
-    S::store(at(pairs, x, 2), S::add(S::load(d + x), S::load(d + x + 1)));
-    S::store(at(pairs, x, 3), S::add(S::load(u + x), S::load(u + x + 1)));
-    S::store(at(pairs, x, 4), S::add(S::load(v + x), S::load(v + x + 1)));
+    S::store(at(pairs, x, 2), S::add(d0, S::next1(d0, d2)));
+    S::store(at(pairs, x, 3), S::add(u0, S::next1(u0, u2)));
+    S::store(at(pairs, x, 4), S::add(v0, S::next1(v0, v2)));
+    m0 = m2;
+    d0 = d2;
+    u0 = u2;
+    v0 = v2;
   }
 }
 
@@ -346,26 +401,27 @@ void resum_row_t(int x0, int x1, const float* const* row_list, int count, float*
   for (int c = 0; c < kChannels; ++c)
     carry[c] = S::load(carry_mem + c * S::N);
   for (int x = x0; x < x1; x += S::N) {
-    F sum[kChannels], term[kChannels], first[kChannels], last[kChannels];
+    F sum[kChannels], term[kChannels];
     ring_terms<kRobust>(rows[0], x, sum);
     for (int r = 1; r < count; ++r) {
       ring_terms<kRobust>(rows[r], x, term);
       for (int c = 0; c < kChannels; ++c)
         sum[c] = S::add(sum[c], term[c]);
     }
-    if (prefix && top) {
+    for (int c = 0; c < kChannels; ++c)
+      S::store(at(acc, x, c), sum[c]);
+    if (!prefix) continue;
+    if (top) {
+      F first[kChannels], last[kChannels];
       ring_terms<kRobust>(top, x, first);
       ring_terms<kRobust>(bot, x, last);
-    }
-    for (int c = 0; c < kChannels; ++c) {
-      S::store(at(acc, x, c), sum[c]);
-      if (!prefix) continue;
-      if (top) {
+      for (int c = 0; c < kChannels; ++c) {
         prefix_out<true>(sum[c], last[c], first[c], x, c, col, col_stride, prefix, pstride,
                          carry[c]);
-      } else {
-        prefix_out<false>(sum[c], sum[c], sum[c], x, c, col, col_stride, prefix, pstride, carry[c]);
       }
+    } else {
+      for (int c = 0; c < kChannels; ++c)
+        prefix_out<false>(sum[c], sum[c], sum[c], x, c, col, col_stride, prefix, pstride, carry[c]);
     }
   }
   for (int c = 0; c < kChannels; ++c)
