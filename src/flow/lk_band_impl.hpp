@@ -41,7 +41,7 @@ Layout layout_of(const LevelJob& L) {
   s.slot = 2 * s.wrow + kChannels * wp;
   s.ring_rows = L.hi - L.lo + 1;
   s.ring = 4 * s.slot;
-  s.acc = s.ring + s.ring_rows * kChannels * wp;
+  s.acc = s.ring + s.ring_rows * kFactors * wp;
   s.col = s.acc + kChannels * wp;
   s.col_pad = round_up(-L.lo, 16);
   s.col_stride = round_up(s.col_pad + wp + L.hi + 1, 16);
@@ -114,7 +114,7 @@ class RowPass {
  private:
   float* ring_row(int s) const {
     const int n = static_cast<int>(s_.ring_rows);
-    return ring_ + static_cast<Idx>(((s % n) + n) % n) * kChannels * L_->wp;
+    return ring_ + static_cast<Idx>(((s % n) + n) % n) * kFactors * L_->wp;
   }
 
   // Columns [x0, x1) of warped row r (and its Horn–Schunck pairs up to the vector end xe).
@@ -220,8 +220,8 @@ class RowPass {
       enter(x0, xe, t, L.inv_s2, ring, acc_, top, col_, s_.col_stride, prefix_, s_.prefix_stride,
             carry_);
       if (resum) {
-        resum_row(x0, xe, resum_rows, resum_count, acc_, top, ring, col_, s_.col_stride,
-                  solve ? prefix_ : nullptr, s_.prefix_stride, carry_);
+        resum_row(L.inv_s2 > 0.f, x0, xe, resum_rows, resum_count, acc_, top, ring, col_,
+                  s_.col_stride, solve ? prefix_ : nullptr, s_.prefix_stride, carry_);
       }
       if (solve && x1 < w) {
         // A vector's solve reads prefix sums up to hi columns past its end.

@@ -20,6 +20,7 @@ using simd::Scalar;
 using Idx = std::ptrdiff_t;
 
 constexpr int kChannels = 5;  // gxx, gxy, gyy, bx, by
+constexpr int kFactors = 4;   // what a ring row keeps per pixel: Ix, Iy, r, robust weight
 constexpr int kPad = 16;      // floats before and after each warped row (64 bytes)
 
 int imin(int a, int b) {
@@ -54,6 +55,50 @@ struct WarpGeometry {
   int dx1, dy1;  // offsets of the right and lower neighbours (0 on a one-pixel side)
 };
 
+// The four taps of a vector whose samples lie in one row or two adjacent ones, less than 31
+// columns apart, by two loads of 32 columns per row, permutes and, over two rows, a per-lane
+// choice (a gather loads lane by lane): false where they do not, or without two-vector permutes.
+template <class S>
+ROIFLOW_INLINE bool near_taps(const WarpGeometry& g, typename S::I ix, typename S::I iy,
+                              typename S::F& p00, typename S::F& p01, typename S::F& p10,
+                              typename S::F& p11) {
+  if constexpr (!S::kPermute2) {
+    return false;
+  } else {
+    using F = typename S::F;
+    using I = typename S::I;
+    using M = typename S::M;
+    constexpr int N = S::N;
+    // A little left of lane 0's column: the flow may pull later lanes left of it.
+    const std::int32_t x = imax(0, imin(S::first(ix) - 4, g.ixmax + 2 - 2 * N));
+    const I rel = S::subi(ix, S::seti(x));
+    if (x + 2 * N > g.ixmax + 2 || !S::all(S::below(rel, 2 * N - 1))) return false;
+    // The upper row: lane 0's, or the one above it (flow near zero rounds either way).
+    const std::int32_t y0 = S::first(iy);
+    const std::int32_t y = S::any(S::eqi(iy, S::seti(y0 - 1))) ? y0 - 1 : y0;
+    const M upper = S::eqi(iy, S::seti(y));
+    const bool one_row = S::all(upper);
+    if (!one_row && !S::all(S::either(upper, S::eqi(iy, S::seti(y + 1))))) return false;
+    const I rel1 = S::addi(rel, S::seti(1));
+    const float* r0 = g.base + static_cast<Idx>(y) * g.step + x;
+    const float* r1 = r0 + g.step;
+    const F a0 = S::load(r0), a1 = S::load(r0 + N), b0 = S::load(r1), b1 = S::load(r1 + N);
+    p00 = S::permute2(a0, a1, rel);
+    p01 = S::permute2(a0, a1, rel1);
+    p10 = S::permute2(b0, b1, rel);
+    p11 = S::permute2(b0, b1, rel1);
+    if (one_row) return true;
+    // Lanes on row y + 1 (which is then at most the last but one) take rows y + 1 and y + 2.
+    const float* r2 = r1 + g.step;
+    const F c0 = S::load(r2), c1 = S::load(r2 + N);
+    p00 = S::select(upper, p00, p10);
+    p01 = S::select(upper, p01, p11);
+    p10 = S::select(upper, p10, S::permute2(c0, c1, rel));
+    p11 = S::select(upper, p11, S::permute2(c0, c1, rel1));
+    return true;
+  }
+}
+
 template <class S>
 ROIFLOW_INLINE void warp_block(const WarpGeometry& g, float fx0, float fy, const float* u,
                                const float* v, const float* i0, float* m, float* d,
@@ -78,7 +123,7 @@ ROIFLOW_INLINE void warp_block(const WarpGeometry& g, float fx0, float fy, const
     p01 = S::load(p + 1);
     p10 = S::load(p + g.step);
     p11 = S::load(p + g.step + 1);
-  } else {
+  } else if (!may_load_rows || !near_taps<S>(g, ix, iy, p00, p01, p10, p11)) {
     p00 = S::gather(g.base, idx);
     p01 = S::gather(g.base, S::addi(idx, S::seti(g.dx1)));
     p10 = S::gather(g.base, S::addi(idx, S::seti(g.dy1)));
@@ -161,21 +206,39 @@ ROIFLOW_INLINE float* at(float* row, int x, int c) {
 ROIFLOW_INLINE const float* at(const float* row, int x, int c) {
   return row + kChannels * x + c * Native::N;
 }
+// Ring rows: factor f of the vector at column x.
+ROIFLOW_INLINE float* at_factor(float* row, int x, int f) {
+  return row + kFactors * x + f * Native::N;
+}
+ROIFLOW_INLINE const float* at_factor(const float* row, int x, int f) {
+  return row + kFactors * x + f * Native::N;
+}
 
 // Horn–Schunck works on the 2x2x2 cube between warped rows s, s + 1 and columns x, x + 1 (grid
 // at +1/2). Each warped row's column pairs are formed once (it serves two derivative-grid rows):
 // Dm = m[x+1] - m[x], Sm = m[x] + m[x+1], Sd, Su, Sv likewise (interleaved like the ring). Flow
 // rows: column w holds column w - 1, so x + 1 is the replicated neighbour at the last column.
+// Column x + 1 comes from the next vector in registers (aligned loads only: a load one column
+// off spans two vectors the warp has just stored, and waits for both to leave the store queue).
 void hs_pairs(int x0, int x1, const float* m, const float* d, const float* u, const float* v,
               float* pairs) {
   using S = Native;
+  using F = S::F;
+  if (x0 >= x1) return;
+  F m0 = S::load(m + x0), d0 = S::load(d + x0), u0 = S::load(u + x0), v0 = S::load(v + x0);
   for (int x = x0; x < x1; x += S::N) {
-    const S::F m0 = S::load(m + x), m1 = S::load(m + x + 1);
+    const int n = x + S::N;
+    const F m2 = S::load(m + n), d2 = S::load(d + n), u2 = S::load(u + n), v2 = S::load(v + n);
+    const F m1 = S::next1(m0, m2);
     S::store(at(pairs, x, 0), S::sub(m1, m0));
     S::store(at(pairs, x, 1), S::add(m0, m1));
-    S::store(at(pairs, x, 2), S::add(S::load(d + x), S::load(d + x + 1)));
-    S::store(at(pairs, x, 3), S::add(S::load(u + x), S::load(u + x + 1)));
-    S::store(at(pairs, x, 4), S::add(S::load(v + x), S::load(v + x + 1)));
+    S::store(at(pairs, x, 2), S::add(d0, S::next1(d0, d2)));
+    S::store(at(pairs, x, 3), S::add(u0, S::next1(u0, u2)));
+    S::store(at(pairs, x, 4), S::add(v0, S::next1(v0, v2)));
+    m0 = m2;
+    d0 = d2;
+    u0 = u2;
+    v0 = v2;
   }
 }
 
@@ -188,13 +251,15 @@ struct TermRows {
   const float *d1 = nullptr, *u1 = nullptr, *v1 = nullptr;
 };
 
+// The factors of row s's window terms at the vector of column x: Ix, Iy, r and, when robust,
+// the weight (all zero outside the rectangle).
 template <int kDeriv, bool kRobust>
-ROIFLOW_INLINE void products(const TermRows& t, int x, Native::F inv_s2, Native::F* p) {
+ROIFLOW_INLINE void factors(const TermRows& t, int x, Native::F inv_s2, Native::F* f) {
   using S = Native;
   using F = S::F;
   if constexpr (kDeriv == kOutside) {
-    for (int c = 0; c < kChannels; ++c)
-      p[c] = S::set1(0.f);
+    for (int c = 0; c < kFactors; ++c)
+      f[c] = S::set1(0.f);
     return;
   } else {
     F ix, iy, it, ub, vb;
@@ -228,32 +293,51 @@ ROIFLOW_INLINE void products(const TermRows& t, int x, Native::F inv_s2, Native:
       ub = S::load(t.u1 + x);
       vb = S::load(t.v1 + x);
     }
-    F wix = ix, wiy = iy;
-    if constexpr (kRobust) {
-      const F wgt = S::recip(S::madd(S::mul(it, it), inv_s2, S::set1(1.f)));
-      wix = S::mul(wgt, ix);
-      wiy = S::mul(wgt, iy);
-    }
-    const F r = S::sub(S::madd(iy, vb, S::mul(ix, ub)), it);
-    p[0] = S::mul(wix, ix);
-    p[1] = S::mul(wix, iy);
-    p[2] = S::mul(wiy, iy);
-    p[3] = S::mul(wix, r);
-    p[4] = S::mul(wiy, r);
+    f[0] = ix;
+    f[1] = iy;
+    f[2] = S::sub(S::madd(iy, vb, S::mul(ix, ub)), it);
+    if constexpr (kRobust) f[3] = S::recip(S::madd(S::mul(it, it), inv_s2, S::set1(1.f)));
   }
 }
 
+// The five window terms from their factors. The ring keeps the factors, not the terms (fewer
+// bytes to store and to read back when the row leaves the window); every term is then
+// recomputed by the same operations, so it is the same float.
+template <bool kRobust>
+ROIFLOW_INLINE void terms(const Native::F* f, Native::F* p) {
+  using S = Native;
+  Native::F wix = f[0], wiy = f[1];
+  if constexpr (kRobust) {
+    wix = S::mul(f[3], f[0]);
+    wiy = S::mul(f[3], f[1]);
+  }
+  p[0] = S::mul(wix, f[0]);
+  p[1] = S::mul(wix, f[1]);
+  p[2] = S::mul(wiy, f[1]);
+  p[3] = S::mul(wix, f[2]);
+  p[4] = S::mul(wiy, f[2]);
+}
+
+// The terms of ring row `row` at the vector of column x.
+template <bool kRobust>
+ROIFLOW_INLINE void ring_terms(const float* row, int x, Native::F* p) {
+  Native::F f[kFactors];
+  for (int c = 0; c < (kRobust ? 4 : 3); ++c)
+    f[c] = Native::load(at_factor(row, x, c));
+  terms<kRobust>(f, p);
+}
+
 // The output of the vertical sum `sum` of vector x, channel c: the column sum (less half of the
-// window's two end rows with kHalf: `top` its first ring row, `bottom` the last row's term) into
+// window's two end rows with kHalf: `top` the first row's term, `bottom` the last row's) into
 // `col`, and its prefix sum, plus `carry` (the sums of the vectors before), into `prefix`.
 template <bool kHalf>
-ROIFLOW_INLINE void prefix_out(Native::F sum, Native::F bottom, const float* top, int x, int c,
+ROIFLOW_INLINE void prefix_out(Native::F sum, Native::F bottom, Native::F top, int x, int c,
                                float* col, Idx col_stride, float* prefix, Idx pstride,
                                Native::F& carry) {
   using S = Native;
   Native::F column = sum;
   if constexpr (kHalf) {
-    column = S::nmadd(S::set1(0.5f), S::add(S::load(at(top, x, c)), bottom), column);
+    column = S::nmadd(S::set1(0.5f), S::add(top, bottom), column);
     S::store(col + c * col_stride + x, column);
   }
   const Native::F ps = S::add(S::prefix(column), carry);
@@ -261,33 +345,38 @@ ROIFLOW_INLINE void prefix_out(Native::F sum, Native::F bottom, const float* top
   carry = S::last(ps);
 }
 
-// Row s enters the window: its terms into the ring slot `ring` (which holds the leaving row's
-// terms when kLeaving) and the vertical sums; with kPrefix, the sums' horizontal prefix sums
-// (of the half-weight column sums when `top`, the window's first ring row, is given: `ring` is
-// then its last) into `prefix` (planar, `pstride` apart) and the column sums into `col`.
+// Row s enters the window: its factors into the ring slot `ring` (which holds the leaving row's
+// when kLeaving) and its terms into the vertical sums; with kPrefix, the sums' horizontal prefix
+// sums (of the half-weight column sums when `top`, the window's first ring row, is given: `ring`
+// is then its last) into `prefix` (planar, `pstride` apart) and the column sums into `col`.
 template <int kDeriv, bool kRobust, bool kLeaving, bool kPrefix, bool kHalf>
 void enter_row_t(int x0, int x1, const TermRows& rows, float inv_s2_value, float* ring, float* acc,
                  const float* top, float* col, Idx col_stride, float* prefix, Idx pstride,
                  float* carry_mem) {
   using S = Native;
   using F = S::F;
+  // Outside rows keep a zero weight too: a robust row leaving reads it.
+  constexpr int kKept = kRobust || kDeriv == kOutside ? 4 : 3;
   const TermRows t = rows;  // a local: the stores below could alias `rows`
   const F inv_s2 = S::set1(inv_s2_value);
   F carry[kChannels];
   for (int c = 0; c < kChannels; ++c)
     carry[c] = S::load(carry_mem + c * S::N);
   for (int x = x0; x < x1; x += S::N) {
-    F term[kChannels];
-    products<kDeriv, kRobust>(t, x, inv_s2, term);
+    F f[kFactors], term[kChannels], gone[kChannels], first[kChannels];
+    factors<kDeriv, kRobust>(t, x, inv_s2, f);
+    terms<kRobust>(f, term);
+    if constexpr (kLeaving) ring_terms<kRobust>(ring, x, gone);
+    if constexpr (kHalf) ring_terms<kRobust>(top, x, first);
+    for (int c = 0; c < kKept; ++c)
+      S::store(at_factor(ring, x, c), f[c]);
     for (int c = 0; c < kChannels; ++c) {
-      float* rc = at(ring, x, c);
       float* ac = at(acc, x, c);
       const F old = S::load(ac);
-      const F sum = kLeaving ? S::add(old, S::sub(term[c], S::load(rc))) : S::add(old, term[c]);
-      S::store(rc, term[c]);
+      const F sum = kLeaving ? S::add(old, S::sub(term[c], gone[c])) : S::add(old, term[c]);
       S::store(ac, sum);
       if constexpr (kPrefix) {
-        prefix_out<kHalf>(sum, term[c], top, x, c, col, col_stride, prefix, pstride, carry[c]);
+        prefix_out<kHalf>(sum, term[c], first[c], x, c, col, col_stride, prefix, pstride, carry[c]);
       }
     }
   }
@@ -295,12 +384,14 @@ void enter_row_t(int x0, int x1, const TermRows& rows, float inv_s2_value, float
     S::store(carry_mem + c * S::N, carry[c]);
 }
 
-// Fresh window sums: acc = the window's ring rows added top to bottom (then their prefix sums as
-// in enter_row, unless `prefix` is null). A running sum's rounding depends on where it started:
-// summing afresh every `stripe` rows makes every row independent of where its pass began.
-void resum_row(int x0, int x1, const float* const* row_list, int count, float* acc,
-               const float* top, const float* bot, float* col, Idx col_stride, float* prefix,
-               Idx pstride, float* carry_mem) {
+// Fresh window sums: acc = the terms of the window's ring rows added top to bottom (then their
+// prefix sums as in enter_row, unless `prefix` is null). A running sum's rounding depends on
+// where it started: summing afresh every `stripe` rows makes every row independent of where its
+// pass began.
+template <bool kRobust>
+void resum_row_t(int x0, int x1, const float* const* row_list, int count, float* acc,
+                 const float* top, const float* bot, float* col, Idx col_stride, float* prefix,
+                 Idx pstride, float* carry_mem) {
   const float* rows[64];
   for (int r = 0; r < count; ++r)
     rows[r] = row_list[r];
@@ -310,22 +401,42 @@ void resum_row(int x0, int x1, const float* const* row_list, int count, float* a
   for (int c = 0; c < kChannels; ++c)
     carry[c] = S::load(carry_mem + c * S::N);
   for (int x = x0; x < x1; x += S::N) {
-    for (int c = 0; c < kChannels; ++c) {
-      F sum = S::load(at(rows[0], x, c));
-      for (int r = 1; r < count; ++r)
-        sum = S::add(sum, S::load(at(rows[r], x, c)));
-      S::store(at(acc, x, c), sum);
-      if (!prefix) continue;
-      if (top) {
-        prefix_out<true>(sum, S::load(at(bot, x, c)), top, x, c, col, col_stride, prefix, pstride,
+    F sum[kChannels], term[kChannels];
+    ring_terms<kRobust>(rows[0], x, sum);
+    for (int r = 1; r < count; ++r) {
+      ring_terms<kRobust>(rows[r], x, term);
+      for (int c = 0; c < kChannels; ++c)
+        sum[c] = S::add(sum[c], term[c]);
+    }
+    for (int c = 0; c < kChannels; ++c)
+      S::store(at(acc, x, c), sum[c]);
+    if (!prefix) continue;
+    if (top) {
+      F first[kChannels], last[kChannels];
+      ring_terms<kRobust>(top, x, first);
+      ring_terms<kRobust>(bot, x, last);
+      for (int c = 0; c < kChannels; ++c) {
+        prefix_out<true>(sum[c], last[c], first[c], x, c, col, col_stride, prefix, pstride,
                          carry[c]);
-      } else {
-        prefix_out<false>(sum, sum, top, x, c, col, col_stride, prefix, pstride, carry[c]);
       }
+    } else {
+      for (int c = 0; c < kChannels; ++c)
+        prefix_out<false>(sum[c], sum[c], sum[c], x, c, col, col_stride, prefix, pstride, carry[c]);
     }
   }
   for (int c = 0; c < kChannels; ++c)
     S::store(carry_mem + c * S::N, carry[c]);
+}
+
+void resum_row(bool robust, int x0, int x1, const float* const* row_list, int count, float* acc,
+               const float* top, const float* bot, float* col, Idx col_stride, float* prefix,
+               Idx pstride, float* carry_mem) {
+  if (robust) {
+    return resum_row_t<true>(x0, x1, row_list, count, acc, top, bot, col, col_stride, prefix,
+                             pstride, carry_mem);
+  }
+  resum_row_t<false>(x0, x1, row_list, count, acc, top, bot, col, col_stride, prefix, pstride,
+                     carry_mem);
 }
 
 struct SolveRow {
@@ -454,8 +565,9 @@ EnterFn pick_enter(int deriv, bool robust, bool leaving, bool prefix, bool half)
     case kCentral:
       return robust ? pick_enter_flags<kCentral, true>(leaving, prefix, half)
                     : pick_enter_flags<kCentral, false>(leaving, prefix, half);
-    default:
-      return pick_enter_flags<kOutside, false>(leaving, prefix, half);
+    default:  // (the leaving row's terms are recomputed with its weight when robust)
+      return robust ? pick_enter_flags<kOutside, true>(leaving, prefix, half)
+                    : pick_enter_flags<kOutside, false>(leaving, prefix, half);
   }
 }
 

@@ -66,6 +66,8 @@ struct Scalar {
   using I = std::int32_t;
   using M = bool;
   static constexpr int N = 1;
+  // Whether permute2, below, any and either exist (two-vector permutes: AVX-512 only).
+  static constexpr bool kPermute2 = false;
   ROIFLOW_INLINE static F load(const float* p) { return *p; }
   ROIFLOW_INLINE static void store(float* p, F a) { *p = a; }
   ROIFLOW_INLINE static F set1(float a) { return a; }
@@ -146,6 +148,10 @@ struct Scalar {
   ROIFLOW_INLINE static F last(F a) {
     return a;
   }
+  // The lanes one column to the right: a's lanes 1.., then b's lane 0 (b: the next vector).
+  ROIFLOW_INLINE static F next1(F, F b) {
+    return b;
+  }
   ROIFLOW_INLINE static F load_u8(const std::uint8_t* p) {
     return static_cast<F>(*p);
   }
@@ -162,6 +168,8 @@ struct Native {
   using I = __m512i;
   using M = __mmask16;
   static constexpr int N = 16;
+  // Whether permute2, below, any and either exist (two-vector permutes: AVX-512 only).
+  static constexpr bool kPermute2 = true;
   ROIFLOW_INLINE static F load(const float* p) { return _mm512_loadu_ps(p); }
   ROIFLOW_INLINE static void store(float* p, F a) { _mm512_storeu_ps(p, a); }
   ROIFLOW_INLINE static F set1(float a) { return _mm512_set1_ps(a); }
@@ -217,6 +225,20 @@ struct Native {
   }
   // The last lane in every lane.
   ROIFLOW_INLINE static F last(F a) { return _mm512_permutexvar_ps(_mm512_set1_epi32(15), a); }
+  // Lane i: lane idx[i] of the 32 lanes of lo and hi.
+  ROIFLOW_INLINE static F permute2(F lo, F hi, I idx) {
+    return _mm512_permutex2var_ps(lo, idx, hi);
+  }
+  // The lanes with 0 <= a < n.
+  ROIFLOW_INLINE static M below(I a, std::int32_t n) {
+    return _mm512_cmplt_epu32_mask(a, _mm512_set1_epi32(n));
+  }
+  ROIFLOW_INLINE static bool any(M m) { return m != 0; }
+  ROIFLOW_INLINE static M either(M a, M b) { return a | b; }
+  ROIFLOW_INLINE static F next1(F a, F b) {
+    return _mm512_castsi512_ps(
+        _mm512_alignr_epi32(_mm512_castps_si512(b), _mm512_castps_si512(a), 1));
+  }
   ROIFLOW_INLINE static F load_u8(const std::uint8_t* p) {
     return _mm512_cvtepi32_ps(
         _mm512_cvtepu8_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p))));
@@ -235,6 +257,8 @@ struct Native {
   using I = __m256i;
   using M = __m256i;
   static constexpr int N = 8;
+  // Whether permute2, below, any and either exist (two-vector permutes: AVX-512 only).
+  static constexpr bool kPermute2 = false;
   ROIFLOW_INLINE static F load(const float* p) { return _mm256_loadu_ps(p); }
   ROIFLOW_INLINE static void store(float* p, F a) { _mm256_storeu_ps(p, a); }
   ROIFLOW_INLINE static F set1(float a) { return _mm256_set1_ps(a); }
@@ -283,6 +307,11 @@ struct Native {
     const __m256 l = _mm256_permute_ps(a, _MM_SHUFFLE(3, 3, 3, 3));
     return _mm256_permute2f128_ps(l, l, 0x11);
   }
+  ROIFLOW_INLINE static F next1(F a, F b) {
+    // [a's high half, b's low half], then each 128-bit half shifted by one lane.
+    const __m256i t = _mm256_castps_si256(_mm256_permute2f128_ps(a, b, 0x21));
+    return _mm256_castsi256_ps(_mm256_alignr_epi8(t, _mm256_castps_si256(a), 4));
+  }
   ROIFLOW_INLINE static F load_u8(const std::uint8_t* p) {
     return _mm256_cvtepi32_ps(
         _mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p))));
@@ -299,6 +328,8 @@ struct Native {
   using I = __m128i;
   using M = __m128i;
   static constexpr int N = 4;
+  // Whether permute2, below, any and either exist (two-vector permutes: AVX-512 only).
+  static constexpr bool kPermute2 = false;
   ROIFLOW_INLINE static F load(const float* p) { return _mm_loadu_ps(p); }
   ROIFLOW_INLINE static void store(float* p, F a) { _mm_storeu_ps(p, a); }
   ROIFLOW_INLINE static F set1(float a) { return _mm_set1_ps(a); }
@@ -347,6 +378,10 @@ struct Native {
     return _mm_add_ps(x, _mm_castsi128_ps(_mm_slli_si128(_mm_castps_si128(x), 8)));
   }
   ROIFLOW_INLINE static F last(F a) { return _mm_shuffle_ps(a, a, _MM_SHUFFLE(3, 3, 3, 3)); }
+  ROIFLOW_INLINE static F next1(F a, F b) {
+    const F t = _mm_move_ss(a, b);  // b0 a1 a2 a3
+    return _mm_shuffle_ps(t, t, _MM_SHUFFLE(0, 3, 2, 1));
+  }
   ROIFLOW_INLINE static F load_u8(const std::uint8_t* p) {
     std::int32_t word;
     std::memcpy(&word, p, 4);
@@ -365,6 +400,8 @@ struct Native {
   using I = int32x4_t;
   using M = uint32x4_t;
   static constexpr int N = 4;
+  // Whether permute2, below, any and either exist (two-vector permutes: AVX-512 only).
+  static constexpr bool kPermute2 = false;
   ROIFLOW_INLINE static F load(const float* p) { return vld1q_f32(p); }
   ROIFLOW_INLINE static void store(float* p, F a) { vst1q_f32(p, a); }
   ROIFLOW_INLINE static F set1(float a) { return vdupq_n_f32(a); }
@@ -413,6 +450,7 @@ struct Native {
     return vaddq_f32(x, vextq_f32(zero, x, 2));
   }
   ROIFLOW_INLINE static F last(F a) { return vdupq_laneq_f32(a, 3); }
+  ROIFLOW_INLINE static F next1(F a, F b) { return vextq_f32(a, b, 1); }
   ROIFLOW_INLINE static F load_u8(const std::uint8_t* p) {
     std::uint32_t word;
     std::memcpy(&word, p, 4);

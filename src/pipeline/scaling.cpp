@@ -4,13 +4,13 @@
 
 #include <fmt/format.h>
 #include <algorithm>
-#include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <set>
 
 #include "core/atomic_write.hpp"
 #include "core/error.hpp"
+#include "core/text.hpp"
 #include "pipeline/frame_graph.hpp"
 #include "pipeline/mot_run.hpp"
 #include "pipeline/tbb_executor.hpp"
@@ -28,12 +28,6 @@ struct Measured {
   bool cancelled = false;
   std::string input;
 };
-
-std::string fixed(double value, int decimals) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
-  return buffer;
-}
 
 Measured run_once(const ScalingOptions& o, int threads) {
   // Caps every oneTBB parallel region of this run (the arena below, and anything the stages
