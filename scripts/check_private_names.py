@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""The targets that the sanitizer builds compile as unity sources (the CLI, and the test parts
-marked UNITY in tests/CMakeLists.txt) must not hold a function private to one file (in an
+"""The targets that build as unity sources (the CLI, the eval, report and pipeline libraries, and
+the test parts marked UNITY in tests/CMakeLists.txt) must not hold a function private to one file (in an
 anonymous namespace) whose name another file of the target also gives a private function, or
 that a project header declares: in one unity source, the later file would silently call the
 other function. Lists each such name and exits 1; exits 0 when there is none.
@@ -10,7 +10,8 @@ other function. Lists each such name and exits 1; exits 0 when there is none.
 import collections, glob, os, re, sys
 
 root = sys.argv[1] if len(sys.argv) > 1 else '.'
-targets = {'apps': 'apps/*.cpp'}
+targets = {'apps': 'apps/*.cpp', 'src/eval': 'src/eval/*.cpp', 'src/report': 'src/report/*.cpp',
+           'src/pipeline': 'src/pipeline/*.cpp'}
 tests_cmake = os.path.join(root, 'tests/CMakeLists.txt')
 if os.path.exists(tests_cmake):
     for part, args in re.findall(r'roiflow_add_tests\((\w+)([^)]*)\)', open(tests_cmake).read()):

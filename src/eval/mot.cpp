@@ -53,18 +53,9 @@ std::vector<std::string_view> split_fields(std::string_view line) {
   return fields;
 }
 
-double parse_number(std::string_view field, const char* name, const LineError& error) {
-  double value = 0;
-  const auto [end, ec] = std::from_chars(field.data(), field.data() + field.size(), value);
-  if (ec != std::errc() || end != field.data() + field.size() || !std::isfinite(value)) {
-    error.fail(std::string(name) + " " + quoted_excerpt(field) + " is not a finite number");
-  }
-  return value;
-}
-
 // Frames and ids are integers; some tools write them as "1.0" or "1.000000".
-int parse_integer(std::string_view field, const char* name, int min, const LineError& error) {
-  const double value = parse_number(field, name, error);
+int parse_mot_integer(std::string_view field, const char* name, int min, const LineError& error) {
+  const double value = error.number(field, name);
   if (value != std::floor(value) || value < min || value > std::numeric_limits<int>::max()) {
     error.fail(std::string(name) + " " + quoted_excerpt(field) +
                " is not an integer >= " + std::to_string(min));
@@ -72,30 +63,30 @@ int parse_integer(std::string_view field, const char* name, int min, const LineE
   return static_cast<int>(value);
 }
 
-MotBox parse_row(const std::vector<std::string_view>& f, const LineError& error) {
+MotBox parse_mot_row(const std::vector<std::string_view>& f, const LineError& error) {
   if (f.size() < 6 || f.size() > 10) {
     error.fail("expected 6 to 10 fields (frame,id,x,y,w,h,conf,...), got " +
                std::to_string(f.size()));
   }
   MotBox b;
-  b.frame = parse_integer(f[0], "frame", 1, error);
-  b.id = parse_integer(f[1], "id", 0, error);
-  b.box.x = parse_number(f[2], "x", error);
-  b.box.y = parse_number(f[3], "y", error);
-  b.box.width = parse_number(f[4], "w", error);
-  b.box.height = parse_number(f[5], "h", error);
+  b.frame = parse_mot_integer(f[0], "frame", 1, error);
+  b.id = parse_mot_integer(f[1], "id", 0, error);
+  b.box.x = error.number(f[2], "x");
+  b.box.y = error.number(f[3], "y");
+  b.box.width = error.number(f[4], "w");
+  b.box.height = error.number(f[5], "h");
   if (b.box.width < 0 || b.box.height < 0) {
     error.fail("negative box size " + std::string(f[4]) + "x" + std::string(f[5]));
   }
-  if (f.size() >= 7) b.conf = parse_number(f[6], "conf", error);
+  if (f.size() >= 7) b.conf = error.number(f[6], "conf");
   if (f.size() == 8 || f.size() == 9) {
-    b.object_class = parse_integer(f[7], "class", 1, error);
+    b.object_class = parse_mot_integer(f[7], "class", 1, error);
     if (b.object_class > 13) {
       error.fail("class " + quoted_excerpt(f[7]) + " is not a MOTChallenge class (1..13)");
     }
   }
   if (f.size() == 9) {
-    b.visibility = parse_number(f[8], "visibility", error);
+    b.visibility = error.number(f[8], "visibility");
     if (b.visibility < 0 || b.visibility > 1) {
       error.fail("visibility " + quoted_excerpt(f[8]) + " is not in 0..1");
     }
@@ -177,7 +168,7 @@ std::vector<MotBox> parse_mot(std::string_view text, const std::string& name) {
   std::vector<long long> line_of;
   for_each_line(text, [&](long long number, std::string_view line) {
     if (trim(line).empty()) return;
-    boxes.push_back(parse_row(split_fields(line), LineError(name, number)));
+    boxes.push_back(parse_mot_row(split_fields(line), LineError(name, number)));
     line_of.push_back(number);
   });
   std::vector<std::size_t> order(boxes.size());

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <initializer_list>
 #include <limits>
@@ -21,11 +20,9 @@ namespace {
 
 constexpr const char* kGroundTruth = "groundtruth_rect.txt";
 
-std::string fixed(double value, int decimals) {
-  if (!std::isfinite(value)) return "nan";
-  char text[64];
-  std::snprintf(text, sizeof text, "%.*f", decimals, value);
-  return text;
+// fixed() of core/text.hpp, but "nan" for any value that is not finite (an empty sequence's).
+std::string fixed_or_nan(double value, int decimals) {
+  return std::isfinite(value) ? fixed(value, decimals) : std::string("nan");
 }
 
 bool regular_file(const fs::path& p) {
@@ -69,7 +66,7 @@ std::string md_cell(const std::string& text) {
 std::string share_text(const BenchmarkRow& r) {
   const double share = r.lost_share();
   if (!std::isfinite(share)) return "- (0 frames)";
-  return fixed(share, 2) + " (" + std::to_string(r.zero_iou_lost) + "/" +
+  return fixed_or_nan(share, 2) + " (" + std::to_string(r.zero_iou_lost) + "/" +
          std::to_string(r.zero_iou) + ")";
 }
 
@@ -233,7 +230,7 @@ std::string format_benchmark_markdown(const std::vector<BenchmarkRow>& rows,
     for (const BenchmarkRow& m : means) {
       const auto it = by.find({s, m.tracker});
       md += ' ';
-      md += it == by.end() ? std::string("-") : fixed(it->second->auc, 3);
+      md += it == by.end() ? std::string("-") : fixed_or_nan(it->second->auc, 3);
       md += " |";
     }
     md += "\n";
@@ -241,7 +238,7 @@ std::string format_benchmark_markdown(const std::vector<BenchmarkRow>& rows,
   md += "| **mean** |";
   for (const BenchmarkRow& m : means) {
     md += " **";
-    md += fixed(m.auc, 3);
+    md += fixed_or_nan(m.auc, 3);
     md += "** |";
   }
   md +=
@@ -262,14 +259,14 @@ std::string format_benchmark_markdown(const std::vector<BenchmarkRow>& rows,
                 std::to_string(r.frames),
                 " | ",
                 b,
-                fixed(r.auc, 3),
+                fixed_or_nan(r.auc, 3),
                 b,
                 " | ",
-                fixed(r.precision20, 3),
+                fixed_or_nan(r.precision20, 3),
                 " | ",
-                fixed(r.mean_iou, 3),
+                fixed_or_nan(r.mean_iou, 3),
                 " | ",
-                fixed(r.fps, 1),
+                fixed_or_nan(r.fps, 1),
                 " | ",
                 std::to_string(r.lost),
                 " | ",
@@ -291,11 +288,11 @@ std::string format_benchmark_csv(const std::vector<BenchmarkRow>& rows,
   const auto line = [&](const BenchmarkRow& r) {
     const double share = r.lost_share();
     csv += csv_field(r.sequence) + "," + csv_field(r.tracker) + "," + std::to_string(r.frames) +
-           "," + std::to_string(r.scored) + "," + fixed(r.auc, 4) + "," + fixed(r.precision20, 4) +
-           "," + fixed(r.mean_iou, 4) + "," + fixed(r.fps, 2) + "," + fixed(r.cpu_s, 4) + "," +
-           std::to_string(r.lost) + "," + std::to_string(r.zero_iou) + "," +
-           std::to_string(r.zero_iou_lost) + "," +
-           (std::isfinite(share) ? fixed(share, 4) : std::string()) + "\n";
+           "," + std::to_string(r.scored) + "," + fixed_or_nan(r.auc, 4) + "," +
+           fixed_or_nan(r.precision20, 4) + "," + fixed_or_nan(r.mean_iou, 4) + "," +
+           fixed_or_nan(r.fps, 2) + "," + fixed_or_nan(r.cpu_s, 4) + "," + std::to_string(r.lost) +
+           "," + std::to_string(r.zero_iou) + "," + std::to_string(r.zero_iou_lost) + "," +
+           (std::isfinite(share) ? fixed_or_nan(share, 4) : std::string()) + "\n";
   };
   for (const BenchmarkRow& r : rows)
     line(r);

@@ -92,7 +92,7 @@ cv::Rect2f parse_box_values(const std::vector<std::string_view>& text, std::size
 }
 
 // An integer value of a TinyTLP line (its frame number or its absent flag).
-long long parse_integer(std::string_view t, std::size_t index, const std::string& where) {
+long long parse_tlp_integer(std::string_view t, std::size_t index, const std::string& where) {
   long long value = 0;
   const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), value);
   if (ec != std::errc() || end != t.data() + t.size()) {
@@ -106,8 +106,8 @@ constexpr std::size_t kOtbColumns = 4;      // x,y,w,h
 constexpr std::size_t kTinyTlpColumns = 6;  // frame,x,y,w,h,absent
 
 // One line of a file whose first line had `columns` values; `number` is the box's 1-based index.
-cv::Rect2f parse_box(std::string_view line, std::size_t columns, long long number,
-                     const std::string& where) {
+cv::Rect2f parse_truth_line(std::string_view line, std::size_t columns, long long number,
+                            const std::string& where) {
   const std::vector<std::string_view> text = split_values(line, where);
   if (text.size() != columns) {
     if (columns == kTinyTlpColumns) {
@@ -119,12 +119,12 @@ cv::Rect2f parse_box(std::string_view line, std::size_t columns, long long numbe
                 (number == 1 ? " (TinyTLP files have 6: frame,x,y,w,h,absent)" : ""));
   }
   if (columns == kOtbColumns) return parse_box_values(text, 0, line, where);
-  const long long frame = parse_integer(text[0], 0, where);
+  const long long frame = parse_tlp_integer(text[0], 0, where);
   if (frame != number) {
     throw Error(where + "TinyTLP frame number " + std::to_string(frame) + ", expected " +
                 std::to_string(number) + " (frames must run 1, 2, 3, ...)");
   }
-  const long long absent = parse_integer(text[5], 5, where);
+  const long long absent = parse_tlp_integer(text[5], 5, where);
   if (absent != 0 && absent != 1) {
     throw Error(where + "TinyTLP absent flag " + std::string(text[5]) + " is neither 0 nor 1");
   }
@@ -148,7 +148,8 @@ std::vector<cv::Rect2f> parse_ground_truth(std::string_view text, const std::str
       const std::size_t n = split_values(line, where).size();
       columns = n == kTinyTlpColumns ? kTinyTlpColumns : kOtbColumns;
     }
-    boxes.push_back(parse_box(line, columns, static_cast<long long>(boxes.size()) + 1, where));
+    boxes.push_back(
+        parse_truth_line(line, columns, static_cast<long long>(boxes.size()) + 1, where));
   });
   if (boxes.empty()) throw Error("ground truth '" + name + "' holds no box");
   return boxes;
@@ -202,7 +203,7 @@ struct Tally {
   double iou_sum = 0;
 };
 
-Tally tally(const std::vector<cv::Rect2f>& track, const std::vector<cv::Rect2f>& truth) {
+Tally tally_curves(const std::vector<cv::Rect2f>& track, const std::vector<cv::Rect2f>& truth) {
   const std::size_t n = std::min(track.size(), truth.size());
   std::vector<long long> above(kSuccessThresholds, 0);
   std::vector<long long> near(kPrecisionThresholds, 0);
@@ -240,7 +241,7 @@ Tally tally(const std::vector<cv::Rect2f>& track, const std::vector<cv::Rect2f>&
 }  // namespace
 
 OtbCurves otb_curves(const std::vector<cv::Rect2f>& track, const std::vector<cv::Rect2f>& truth) {
-  return tally(track, truth).curves;
+  return tally_curves(track, truth).curves;
 }
 
 double curve_auc(const std::vector<double>& success) {
@@ -251,7 +252,7 @@ double curve_auc(const std::vector<double>& success) {
 }
 
 OtbScore score(const std::vector<cv::Rect2f>& track, const std::vector<cv::Rect2f>& truth) {
-  const Tally t = tally(track, truth);
+  const Tally t = tally_curves(track, truth);
   OtbScore s;
   s.frames = t.curves.frames;
   s.auc = curve_auc(t.curves.success);

@@ -40,25 +40,16 @@ std::vector<std::string_view> split_commas(std::string_view line) {
   return split_view(line, ',');
 }
 
-double parse_number(std::string_view field, const char* name, const LineError& error) {
-  double value = 0;
-  const auto [end, ec] = std::from_chars(field.data(), field.data() + field.size(), value);
-  if (ec != std::errc() || end != field.data() + field.size() || !std::isfinite(value)) {
-    error.fail(std::string(name) + " " + quoted_excerpt(field) + " is not a finite number");
-  }
-  return value;
-}
-
 // Boxes and velocities are floats: a larger value would become infinity (found by fuzzing).
 float parse_float(std::string_view field, const char* name, const LineError& error) {
-  const double value = parse_number(field, name, error);
+  const double value = error.number(field, name);
   if (std::abs(value) > std::numeric_limits<float>::max()) {
     error.fail(std::string(name) + " " + quoted_excerpt(field) + " is too large");
   }
   return static_cast<float>(value);
 }
 
-TrackRecord parse_row(std::string_view line, bool with_id, const LineError& error) {
+TrackRecord parse_log_row(std::string_view line, bool with_id, const LineError& error) {
   std::vector<std::string_view> f = split_commas(line);
   const std::size_t expected = with_id ? 11 : 10;
   if (f.size() != expected) {
@@ -97,7 +88,7 @@ TrackRecord parse_row(std::string_view line, bool with_id, const LineError& erro
   if (f[8] != "0" && f[8] != "1")
     error.fail("lost " + quoted_excerpt(f[8]) + " is neither 0 nor 1");
   r.lost = f[8] == "1";
-  r.ms = parse_number(f[9], "ms", error);
+  r.ms = error.number(f[9], "ms");
   return r;
 }
 
@@ -162,7 +153,7 @@ std::vector<TrackRecord> parse_track_csv(std::string_view text, const std::strin
       with_id = line == kTrackCsvHeader;
       return;
     }
-    records.push_back(parse_row(line, with_id, error));
+    records.push_back(parse_log_row(line, with_id, error));
   });
   if (lines == 0)
     LineError(name, 1).fail("empty file, expected '" + std::string(kTrackCsvHeader) + "'");

@@ -25,7 +25,7 @@ const cv::Scalar kBodies[] = {{30, 30, 150},  {110, 40, 20},  {25, 25, 25},    {
                               {40, 200, 230}, {30, 120, 230}, {195, 195, 190}, {40, 110, 30},
                               {200, 90, 30},  {40, 20, 90},   {160, 60, 160},  {20, 60, 20}};
 
-int scaled_size(double pixels, double scale) {
+int scaled_pixels(double pixels, double scale) {
   return std::max(static_cast<int>(kMinVisibleSide), static_cast<int>(std::lround(pixels * scale)));
 }
 
@@ -93,8 +93,8 @@ TrafficScene::TrafficScene(const TrafficSceneParams& params) : params_(params) {
     Vehicle& vehicle = vehicles_[v];
     vehicle.lane = kLaneOrder[v % kTrafficLanes];
     ++per_lane[vehicle.lane];
-    const int length = scaled_size(rng.uniform(52.0, 84.0), scale);
-    const int across = scaled_size(rng.uniform(28.0, 38.0), scale);
+    const int length = scaled_pixels(rng.uniform(52.0, 84.0), scale);
+    const int across = scaled_pixels(rng.uniform(28.0, 38.0), scale);
     sizes[v] = {length, across};
     longest[vehicle.lane] = std::max(longest[vehicle.lane], static_cast<double>(length));
     vehicle.lateral = rng.uniform(-4.0, 4.0) * scale;

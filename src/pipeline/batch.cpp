@@ -147,8 +147,8 @@ long long run_track(const std::string& video, const fs::path& dir, const BatchOp
   return frames;
 }
 
-long long run_dense(const std::string& video, const fs::path& dir, const BatchOptions& options,
-                    const TbbExecutor& executor, bool& stopped) {
+long long run_dense_job(const std::string& video, const fs::path& dir, const BatchOptions& options,
+                        const TbbExecutor& executor, bool& stopped) {
   stages::VideoSourceParams sp;
   sp.max_frames = options.max_frames;
   stages::VideoSource source(video, sp);
@@ -197,7 +197,7 @@ BatchRow run_one(const std::string& video, const fs::path& out, const std::strin
     bool stopped = false;
     row.frames = options.job == BatchJob::Track
                      ? run_track(video, partial, options, executor, stopped)
-                     : run_dense(video, partial, options, executor, stopped);
+                     : run_dense_job(video, partial, options, executor, stopped);
     row.seconds = std::chrono::duration<double>(Clock::now() - start).count();
     row.fps = row.seconds > 0 ? static_cast<double>(row.frames) / row.seconds : 0.0;
     if (stopped) {

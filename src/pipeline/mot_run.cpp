@@ -18,7 +18,7 @@
 namespace roiflow::pipeline {
 namespace {
 
-report::ObjectsAnnotation annotation(const stages::MotFrame& f) {
+report::ObjectsAnnotation objects_annotation(const stages::MotFrame& f) {
   report::ObjectsAnnotation a;
   a.index = f.index;
   a.born = f.born;
@@ -82,8 +82,8 @@ MotRun track_objects(const FrameSource& source, cv::Size size, double fps,
                    }});
   if (video) {
     sinks.push_back({"video", [&](const MotTrackedFrame& f) {
-                       video->write(
-                           report::annotate_objects(f.frame->picture(), annotation(*f.output)));
+                       video->write(report::annotate_objects(f.frame->picture(),
+                                                             objects_annotation(*f.output)));
                      }});
   }
   sinks.push_back({"progress", [&](const MotTrackedFrame& f) { progress.update(f.seq + 1); }});

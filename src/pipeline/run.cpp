@@ -26,7 +26,7 @@ double stage_ms(const std::vector<report::StageTotal>& stages, const char* name)
   return 0.0;
 }
 
-report::TrackAnnotation annotation(const stages::TrackerOutput& out) {
+report::TrackAnnotation track_annotation(const stages::TrackerOutput& out) {
   report::TrackAnnotation a;
   a.index = out.index;
   a.has_target = out.has_target;
@@ -92,7 +92,7 @@ TrackSummary run_track_stream(const FrameSource& frames, const StreamInfo& info,
   if (video) {
     sinks.push_back({"video", [&](const TrackedFrame& f) {
                        video->write(
-                           report::annotate_frame(f.frame->picture(), annotation(*f.output)));
+                           report::annotate_frame(f.frame->picture(), track_annotation(*f.output)));
                      }});
   }
   sinks.push_back({"progress", [&](const TrackedFrame& f) { progress.update(f.seq + 1); }});

@@ -67,20 +67,6 @@ cv::Mat fit_width(const cv::Mat& image, int width) {
   return small;
 }
 
-// Largest known magnitude of `flow` (0 when none is known).
-double max_magnitude(const cv::Mat& flow) {
-  double max = 0;
-  for (int y = 0; y < flow.rows; ++y) {
-    const float* f = flow.ptr<float>(y);
-    for (int x = 0; x < flow.cols; ++x) {
-      if (flow::is_known_flow(f[2 * x], f[2 * x + 1])) {
-        max = std::max(max, std::hypot(double{f[2 * x]}, double{f[2 * x + 1]}));
-      }
-    }
-  }
-  return max;
-}
-
 // 1, 2, 5, 10, 20, 50, ... : the smallest one >= value (and >= 1 px).
 double nice_scale(double value) {
   double scale = 1;
@@ -189,13 +175,12 @@ void HtmlReport::add(const eval::EvalRow& row, const eval::EvalImages& images) {
   Section section;
   section.row = row;
   const cv::Size size = images.frame0.size();
-  const std::string size_text = std::to_string(size.width) + "x" + std::to_string(size.height);
   // One maximum for both flows, so the same colour means the same motion in both.
-  const double max_flow = max_magnitude(images.truth);
+  const double max_flow = flow::max_magnitude(images.truth);
   const float coding = max_flow > 0 ? static_cast<float>(max_flow) : 1.f;
   const std::string max_text = fixed(max_flow, 2) + " px";
-  section.figures.push_back(
-      {"frame t (" + size_text + ")", data_uri(fit_width(images.frame0, display_width_), ".jpg")});
+  section.figures.push_back({"frame t (" + size_text(size) + ")",
+                             data_uri(fit_width(images.frame0, display_width_), ".jpg")});
   section.figures.push_back(
       {"frame t+1", data_uri(fit_width(images.frame1, display_width_), ".jpg")});
   section.figures.push_back(

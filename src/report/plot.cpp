@@ -98,7 +98,7 @@ Axis log_axis(const Range& r) {
   return axis;
 }
 
-bool drawable(double x, double y, bool x_log) {
+bool plottable(double x, double y, bool x_log) {
   return std::isfinite(x) && std::isfinite(y) && (!x_log || x > 0);
 }
 
@@ -125,7 +125,7 @@ void check_plot(const Plot& plot) {
         throw Error(where + ": series '" + s.name + "' is on the right axis, which has no label");
       }
       for (std::size_t i = 0; i < s.x.size(); ++i)
-        any = any || drawable(s.x[i], s.y[i], plot.x_log);
+        any = any || plottable(s.x[i], s.y[i], plot.x_log);
     }
     if (!any) throw Error(where + " ('" + panel.y_label + "') has no point to draw");
   }
@@ -194,7 +194,7 @@ std::string series_svg(const PlotPanel& panel, bool x_log, const std::function<d
     std::string markers;
     bool pen_down = false;
     for (std::size_t k = 0; k < s.x.size(); ++k) {
-      if (!drawable(s.x[k], s.y[k], x_log)) {
+      if (!plottable(s.x[k], s.y[k], x_log)) {
         pen_down = false;
         continue;
       }
@@ -228,7 +228,7 @@ std::string plot_svg(const Plot& plot) {
     any_right = any_right || !panel.y2_label.empty();
     for (const PlotSeries& s : panel.series) {
       for (std::size_t i = 0; i < s.x.size(); ++i) {
-        if (drawable(s.x[i], s.y[i], plot.x_log)) x_range.add(s.x[i]);
+        if (plottable(s.x[i], s.y[i], plot.x_log)) x_range.add(s.x[i]);
       }
     }
   }
@@ -262,7 +262,7 @@ std::string plot_svg(const Plot& plot) {
     for (const PlotSeries& s : panel.series) {
       Range& r = ranges[s.axis == PlotAxis::Right ? 1 : 0];
       for (std::size_t i = 0; i < s.x.size(); ++i) {
-        if (drawable(s.x[i], s.y[i], plot.x_log)) r.add(s.y[i]);
+        if (plottable(s.x[i], s.y[i], plot.x_log)) r.add(s.y[i]);
       }
     }
     Axis y_axes[2];

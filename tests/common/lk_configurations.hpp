@@ -5,6 +5,11 @@
 //     SCOPED_TRACE(c.name);
 //     roiflow::flow::DenseLK lk(c.params);
 //   }
+//
+// Under ThreadSanitizer (which instruments every load and store of the kernels) the thread tests
+// take thread_configurations(): the paper preset and the accurate one (the paper's method and the
+// project's tuned one); the other sets change the arithmetic more than the threading, and keep
+// their run in the release and AddressSanitizer builds.
 #pragma once
 
 #include <vector>
@@ -46,6 +51,16 @@ inline std::vector<NamedParams> lk_configurations() {
           {"accurate", LkParams::accurate()},
           {"accurate patch 11 scharr",
            with_derivative(with_patch(LkParams::accurate(), 11), flow::Derivative::Scharr)}};
+}
+
+// The sets a test over thread counts runs: all of lk_configurations(), or under ThreadSanitizer
+// (GCC's __SANITIZE_THREAD__) the two presets only.
+inline std::vector<NamedParams> thread_configurations() {
+#ifdef __SANITIZE_THREAD__
+  return {{"paper", flow::LkParams::paper()}, {"accurate", flow::LkParams::accurate()}};
+#else
+  return lk_configurations();
+#endif
 }
 
 }  // namespace roiflow::test

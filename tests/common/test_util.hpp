@@ -17,6 +17,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
+#include <opencv2/core.hpp>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -69,6 +71,19 @@ inline std::vector<std::pair<int, int>> chunks_of(int begin, int end, int grain)
 inline std::string read_text(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+inline void write_text(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary) << text;
+}
+
+// The largest absolute difference of two images of one size and type (a failed expectation, and
+// the largest double, when they differ in either).
+inline double max_abs_diff(const cv::Mat& a, const cv::Mat& b) {
+  EXPECT_EQ(a.size(), b.size());
+  EXPECT_EQ(a.type(), b.type());
+  if (a.size() != b.size() || a.type() != b.type()) return std::numeric_limits<double>::max();
+  return cv::norm(a, b, cv::NORM_INF);
 }
 
 inline std::vector<std::string> split(const std::string& text, char separator) {

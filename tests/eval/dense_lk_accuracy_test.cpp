@@ -42,13 +42,6 @@ FlowErrors interior_errors(const cv::Mat& flow, const cv::Mat& truth, int border
   return flow_errors(flow, truth, border_mask(flow.size(), border));
 }
 
-double max_abs_diff(const cv::Mat& a, const cv::Mat& b) {
-  EXPECT_EQ(a.size(), b.size());
-  EXPECT_EQ(a.type(), b.type());
-  if (a.size() != b.size() || a.type() != b.type()) return std::numeric_limits<double>::max();
-  return cv::norm(a, b, cv::NORM_INF);
-}
-
 bool all_finite(const cv::Mat& m) {
   return cv::checkRange(m, true, nullptr, -1e30, 1e30);
 }
@@ -313,12 +306,13 @@ TEST(DenseLkTest, RegionEqualsWholeFrameFlowInsideIt) {
       ASSERT_EQ(part.flow.size(), clipped.size()) << c.name << " " << region;
       ASSERT_EQ(part.flow.type(), CV_32FC2);
       ASSERT_EQ(part.confidence.size(), clipped.size()) << c.name << " " << region;
-      EXPECT_LT(max_abs_diff(part.flow, whole.flow(clipped)), 0.03) << c.name << " " << region;
+      EXPECT_LT(test::max_abs_diff(part.flow, whole.flow(clipped)), 0.03)
+          << c.name << " " << region;
       cv::Mat diff;
       cv::absdiff(part.flow, whole.flow(clipped), diff);
       const cv::Scalar mean_diff = cv::mean(diff);
       EXPECT_LT(std::max(mean_diff[0], mean_diff[1]), 1e-3) << c.name << " " << region;
-      EXPECT_LT(max_abs_diff(part.confidence, whole.confidence(clipped)), 1e-6)
+      EXPECT_LT(test::max_abs_diff(part.confidence, whole.confidence(clipped)), 1e-6)
           << c.name << " " << region;
     }
   }
@@ -337,9 +331,9 @@ TEST(DenseLkTest, ASmallerContextChangesTheFlowOnlyNearTheRegionBorder) {
   // Away from the border (more than a window and the context), the two agree closely; at the
   // border they may not, which is why exact context stays the default.
   const cv::Rect inner(20, 20, region.width - 40, region.height - 40);
-  EXPECT_LT(max_abs_diff(cheap.flow(inner), reference.flow(inner)), 0.05);
-  EXPECT_GT(max_abs_diff(cheap.flow, reference.flow), 1e-4);  // the context was honoured
-  EXPECT_LT(max_abs_diff(cheap.flow, s.flow(region)), 1.0);
+  EXPECT_LT(test::max_abs_diff(cheap.flow(inner), reference.flow(inner)), 0.05);
+  EXPECT_GT(test::max_abs_diff(cheap.flow, reference.flow), 1e-4);  // the context was honoured
+  EXPECT_LT(test::max_abs_diff(cheap.flow, s.flow(region)), 1.0);
   for (int bad : {-2, 1001}) {
     FlowOptions options = exact;
     options.context = bad;
@@ -373,7 +367,7 @@ TEST(DenseLkTest, PyramidsOfTheFootprintGiveTheRegionsFlow) {
     FlowOptions inside = options;
     inside.region = options.region - crop.tl();
     const FlowResult part = dense_flow(s.frame0(crop), s.frame1(crop), params, inside);
-    EXPECT_LT(max_abs_diff(part.flow, whole.flow), 1e-3);
+    EXPECT_LT(test::max_abs_diff(part.flow, whole.flow), 1e-3);
   }
 }
 
@@ -433,7 +427,7 @@ TEST(DenseLkTest, AFinestLevelAboveZeroGivesTheCoarserFlowUpsampled) {
   FlowOptions inside = region;
   inside.region = region.region - crop.tl();
   const FlowResult cropped = dense_flow(s.frame0(crop), s.frame1(crop), params, inside);
-  EXPECT_LT(max_abs_diff(cropped.flow, part.flow), 1e-3);
+  EXPECT_LT(test::max_abs_diff(cropped.flow, part.flow), 1e-3);
   for (int bad : {-1, kMaxLevels}) {
     FlowOptions o;
     o.finest_level = bad;
@@ -454,7 +448,7 @@ TEST(DenseLkTest, FinestIterationsApplyToTheFinestLevelOnly) {
   const FlowResult base = dense_flow(s.frame0, s.frame1, paper);
   LkParams same = paper;
   same.finest_iterations = paper.iterations;
-  EXPECT_EQ(max_abs_diff(dense_flow(s.frame0, s.frame1, same).flow, base.flow), 0.0);
+  EXPECT_EQ(test::max_abs_diff(dense_flow(s.frame0, s.frame1, same).flow, base.flow), 0.0);
 
   LkParams one_level = paper;
   one_level.levels = 1;
@@ -463,8 +457,8 @@ TEST(DenseLkTest, FinestIterationsApplyToTheFinestLevelOnly) {
   LkParams two_iterations = one_level;
   two_iterations.iterations = 2;
   two_iterations.finest_iterations = 0;
-  EXPECT_EQ(max_abs_diff(dense_flow(s.frame0, s.frame1, one_level).flow,
-                         dense_flow(s.frame0, s.frame1, two_iterations).flow),
+  EXPECT_EQ(test::max_abs_diff(dense_flow(s.frame0, s.frame1, one_level).flow,
+                               dense_flow(s.frame0, s.frame1, two_iterations).flow),
             0.0);
 
   LkParams cheap = paper;
@@ -472,8 +466,8 @@ TEST(DenseLkTest, FinestIterationsApplyToTheFinestLevelOnly) {
   LkParams uniform_one = paper;
   uniform_one.iterations = 1;
   const FlowResult r = dense_flow(s.frame0, s.frame1, cheap);
-  EXPECT_GT(max_abs_diff(r.flow, base.flow), 1e-3);
-  EXPECT_GT(max_abs_diff(r.flow, dense_flow(s.frame0, s.frame1, uniform_one).flow), 1e-3);
+  EXPECT_GT(test::max_abs_diff(r.flow, base.flow), 1e-3);
+  EXPECT_GT(test::max_abs_diff(r.flow, dense_flow(s.frame0, s.frame1, uniform_one).flow), 1e-3);
   EXPECT_EQ(cheap.iterations_at(0, 0), 1);
   EXPECT_EQ(cheap.iterations_at(1, 0), paper.iterations);
   EXPECT_EQ(cheap.iterations_at(1, 1), 1);
@@ -486,7 +480,7 @@ TEST(DenseLkTest, FinestIterationsApplyToTheFinestLevelOnly) {
   FlowOptions options;
   options.region = cv::Rect(117, 83, 64, 48);
   const FlowResult part = dense_flow(s.frame0, s.frame1, more, options);
-  EXPECT_LT(max_abs_diff(part.flow, whole.flow(options.region)), 0.03);
+  EXPECT_LT(test::max_abs_diff(part.flow, whole.flow(options.region)), 0.03);
 }
 
 // ---------------------------------------------------------------------------------------------

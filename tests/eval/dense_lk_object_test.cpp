@@ -24,14 +24,7 @@ using eval::Scene;
 using eval::SceneKind;
 using test::error_message;
 
-const cv::Size kSize(160, 120);
-
-double max_abs_diff(const cv::Mat& a, const cv::Mat& b) {
-  EXPECT_EQ(a.size(), b.size());
-  EXPECT_EQ(a.type(), b.type());
-  if (a.size() != b.size() || a.type() != b.type()) return 1e30;
-  return cv::norm(a, b, cv::NORM_INF);
-}
+const cv::Size kObjectSceneSize(160, 120);
 
 std::vector<LkParams> parameter_sets() {
   LkParams scharr = LkParams::accurate();
@@ -45,7 +38,7 @@ Scene colour_scene() {
   Scene planes[3];
   std::vector<cv::Mat> f0, f1;
   for (int c = 0; c < 3; ++c) {
-    planes[c] = make_scene(SceneKind::Rotation, kSize, 20 + c);
+    planes[c] = make_scene(SceneKind::Rotation, kObjectSceneSize, 20 + c);
     f0.push_back(planes[c].frame0);
     f1.push_back(planes[c].frame1);
   }
@@ -57,7 +50,7 @@ Scene colour_scene() {
 }
 
 TEST(DenseLkObjectTest, CalcEqualsDenseFlowBitForBitAndReusesItsWorkspace) {
-  const Scene s = make_scene(SceneKind::NonRigid, kSize, 3);
+  const Scene s = make_scene(SceneKind::NonRigid, kObjectSceneSize, 3);
   const Scene other = make_scene(SceneKind::Zoom, {96, 80}, 4);
   for (const LkParams& params : parameter_sets()) {
     DenseLK lk(params);
@@ -68,47 +61,48 @@ TEST(DenseLkObjectTest, CalcEqualsDenseFlowBitForBitAndReusesItsWorkspace) {
       // Twice on the same buffers, then another size in between and back.
       for (int round = 0; round < 2; ++round) {
         const FlowResult r = lk.calc(s.frame0, s.frame1, options);
-        EXPECT_EQ(max_abs_diff(r.flow, expected.flow), 0.0) << round;
-        EXPECT_EQ(max_abs_diff(r.confidence, expected.confidence), 0.0) << round;
+        EXPECT_EQ(test::max_abs_diff(r.flow, expected.flow), 0.0) << round;
+        EXPECT_EQ(test::max_abs_diff(r.confidence, expected.confidence), 0.0) << round;
         EXPECT_EQ(r.region, expected.region);
       }
       const FlowResult small = lk.calc(other.frame0, other.frame1);
-      EXPECT_EQ(max_abs_diff(small.flow, dense_flow(other.frame0, other.frame1, params).flow), 0.0);
-      EXPECT_EQ(max_abs_diff(lk.calc(s.frame0, s.frame1, options).flow, expected.flow), 0.0);
+      EXPECT_EQ(test::max_abs_diff(small.flow, dense_flow(other.frame0, other.frame1, params).flow),
+                0.0);
+      EXPECT_EQ(test::max_abs_diff(lk.calc(s.frame0, s.frame1, options).flow, expected.flow), 0.0);
       // On pyramids built by the caller.
       const int levels = flow_pyramid_levels(s.frame0.size(), params, options);
       const Pyramid p0 = build_pyramid(s.frame0, levels, params.sigma);
       const Pyramid p1 = build_pyramid(s.frame1, levels, params.sigma);
-      EXPECT_EQ(max_abs_diff(lk.calc(p0, p1, options).flow, expected.flow), 0.0);
+      EXPECT_EQ(test::max_abs_diff(lk.calc(p0, p1, options).flow, expected.flow), 0.0);
     }
   }
 }
 
 TEST(DenseLkObjectTest, CollectGarbageFreesTheWorkspaceAndTheNextCallRebuildsIt) {
-  const Scene s = make_scene(SceneKind::Rotation, kSize, 5);
+  const Scene s = make_scene(SceneKind::Rotation, kObjectSceneSize, 5);
   DenseLK lk(LkParams::paper());
   EXPECT_EQ(lk.workspace_bytes(), 0u);
   const FlowResult first = lk.calc(s.frame0, s.frame1);
   // At least the two pyramids' level 0 and the four flow planes of level 0.
-  const std::size_t least = (2 + 4) * kSize.area() * sizeof(float);
+  const std::size_t least = (2 + 4) * kObjectSceneSize.area() * sizeof(float);
   EXPECT_GE(lk.workspace_bytes(), least);
   const std::size_t held = lk.workspace_bytes();
   lk.calc(s.frame0, s.frame1);
   EXPECT_EQ(lk.workspace_bytes(), held);  // reused, not grown
   lk.collectGarbage();
   EXPECT_EQ(lk.workspace_bytes(), 0u);
-  EXPECT_EQ(max_abs_diff(lk.calc(s.frame0, s.frame1).flow, first.flow), 0.0);
+  EXPECT_EQ(test::max_abs_diff(lk.calc(s.frame0, s.frame1).flow, first.flow), 0.0);
   EXPECT_EQ(lk.workspace_bytes(), held);
   // reserve() takes what a pair of that size takes, and the pair then takes nothing more.
   DenseLK reserved(LkParams::paper());
-  reserved.reserve(kSize);
+  reserved.reserve(kObjectSceneSize);
   EXPECT_EQ(reserved.workspace_bytes(), held);
-  EXPECT_EQ(max_abs_diff(reserved.calc(s.frame0, s.frame1).flow, first.flow), 0.0);
+  EXPECT_EQ(test::max_abs_diff(reserved.calc(s.frame0, s.frame1).flow, first.flow), 0.0);
   EXPECT_EQ(reserved.workspace_bytes(), held);
   // A moved-from object holds nothing; the moved-to one goes on.
   DenseLK moved = std::move(lk);
   EXPECT_EQ(moved.workspace_bytes(), held);
-  EXPECT_EQ(max_abs_diff(moved.calc(s.frame0, s.frame1).flow, first.flow), 0.0);
+  EXPECT_EQ(test::max_abs_diff(moved.calc(s.frame0, s.frame1).flow, first.flow), 0.0);
 }
 
 TEST(DenseLkObjectTest, BadParametersThrowInTheConstructorAndSetParams) {
@@ -138,7 +132,7 @@ TEST(LkKernelsTest, EveryInstructionSetAgreesWithTheBest) {
       detail::set_lk_kernels_for_testing(kinds[i]);
       const FlowResult other = dense_flow(s.frame0, s.frame1, params);
       // Measured (AVX2 and SSE2 against AVX-512): at most 2.5e-4 px apart, 1.9e-6 on average.
-      EXPECT_LT(max_abs_diff(other.flow, best.flow), 1e-3) << kinds[i]->name;
+      EXPECT_LT(test::max_abs_diff(other.flow, best.flow), 1e-3) << kinds[i]->name;
       EXPECT_LT(cv::mean(cv::abs(other.flow - best.flow))[0], 1e-5) << kinds[i]->name;
     }
   }
@@ -149,7 +143,7 @@ TEST(LkKernelsTest, EveryInstructionSetAgreesWithTheBest) {
 // Through cv::DenseOpticalFlow, as an OpenCV user swaps it for DIS.
 
 TEST(CreateDenseLkTest, GrayAndBgrThroughTheOpenCvInterfaceEqualDenseFlow) {
-  const Scene gray = make_scene(SceneKind::Translation, kSize, 7);
+  const Scene gray = make_scene(SceneKind::Translation, kObjectSceneSize, 7);
   const Scene colour = colour_scene();
   for (const LkParams& params : parameter_sets()) {
     const cv::Ptr<cv::DenseOpticalFlow> of = createDenseLK(params);
@@ -158,57 +152,57 @@ TEST(CreateDenseLkTest, GrayAndBgrThroughTheOpenCvInterfaceEqualDenseFlow) {
       cv::Mat flow;
       of->calc(s->frame0, s->frame1, flow);
       EXPECT_EQ(flow.type(), CV_32FC2);
-      EXPECT_EQ(max_abs_diff(flow, expected), 0.0) << s->frame0.channels();
+      EXPECT_EQ(test::max_abs_diff(flow, expected), 0.0) << s->frame0.channels();
     }
   }
   // The colour pair's flow is as good as a gray pair's.
   cv::Mat flow;
   createDenseLK()->calc(colour.frame0, colour.frame1, flow);
-  const cv::Rect inner(16, 16, kSize.width - 32, kSize.height - 32);
+  const cv::Rect inner(16, 16, kObjectSceneSize.width - 32, kObjectSceneSize.height - 32);
   EXPECT_LT(flow_errors(flow(inner), colour.flow(inner)).epe, 0.125);  // measured 0.104 px
 }
 
 TEST(CreateDenseLkTest, InputArrayVariantsAndOutputBuffers) {
-  const Scene s = make_scene(SceneKind::Zoom, kSize, 8);
+  const Scene s = make_scene(SceneKind::Zoom, kObjectSceneSize, 8);
   const cv::Mat expected = dense_flow(s.frame0, s.frame1, LkParams::paper()).flow;
   const cv::Ptr<cv::DenseOpticalFlow> of = createDenseLK();
 
   // A preallocated flow of the right size and type is written in place.
-  cv::Mat flow(kSize, CV_32FC2, cv::Scalar::all(7));
+  cv::Mat flow(kObjectSceneSize, CV_32FC2, cv::Scalar::all(7));
   const uchar* buffer = flow.data;
   of->calc(s.frame0, s.frame1, flow);
   EXPECT_EQ(flow.data, buffer);
-  EXPECT_EQ(max_abs_diff(flow, expected), 0.0);
+  EXPECT_EQ(test::max_abs_diff(flow, expected), 0.0);
   // One of the wrong size or type is replaced.
   cv::Mat wrong(10, 10, CV_8UC1);
   of->calc(s.frame0, s.frame1, wrong);
-  EXPECT_EQ(max_abs_diff(wrong, expected), 0.0);
+  EXPECT_EQ(test::max_abs_diff(wrong, expected), 0.0);
 
   // cv::Mat_ inputs, UMat inputs and a UMat output.
   const cv::Mat1b a = s.frame0, b = s.frame1;
   cv::Mat typed;
   of->calc(a, b, typed);
-  EXPECT_EQ(max_abs_diff(typed, expected), 0.0);
+  EXPECT_EQ(test::max_abs_diff(typed, expected), 0.0);
   cv::UMat ua, ub, uflow;
   s.frame0.copyTo(ua);
   s.frame1.copyTo(ub);
   of->calc(ua, ub, uflow);
-  EXPECT_EQ(max_abs_diff(uflow.getMat(cv::ACCESS_READ), expected), 0.0);
+  EXPECT_EQ(test::max_abs_diff(uflow.getMat(cv::ACCESS_READ), expected), 0.0);
   // A submatrix (not continuous) as input.
-  cv::Mat wide0(kSize.height, kSize.width + 8, CV_8UC1, cv::Scalar(0));
+  cv::Mat wide0(kObjectSceneSize.height, kObjectSceneSize.width + 8, CV_8UC1, cv::Scalar(0));
   cv::Mat wide1 = wide0.clone();
-  s.frame0.copyTo(wide0(cv::Rect(cv::Point(4, 0), kSize)));
-  s.frame1.copyTo(wide1(cv::Rect(cv::Point(4, 0), kSize)));
+  s.frame0.copyTo(wide0(cv::Rect(cv::Point(4, 0), kObjectSceneSize)));
+  s.frame1.copyTo(wide1(cv::Rect(cv::Point(4, 0), kObjectSceneSize)));
   cv::Mat from_views;
-  of->calc(wide0(cv::Rect(cv::Point(4, 0), kSize)), wide1(cv::Rect(cv::Point(4, 0), kSize)),
-           from_views);
-  EXPECT_EQ(max_abs_diff(from_views, expected), 0.0);
+  of->calc(wide0(cv::Rect(cv::Point(4, 0), kObjectSceneSize)),
+           wide1(cv::Rect(cv::Point(4, 0), kObjectSceneSize)), from_views);
+  EXPECT_EQ(test::max_abs_diff(from_views, expected), 0.0);
 
   // collectGarbage through the interface, then the same again.
   of->collectGarbage();
   cv::Mat again;
   of->calc(s.frame0, s.frame1, again);
-  EXPECT_EQ(max_abs_diff(again, expected), 0.0);
+  EXPECT_EQ(test::max_abs_diff(again, expected), 0.0);
 }
 
 TEST(CreateDenseLkTest, BadInputThrowsRoiflowError) {
@@ -226,21 +220,21 @@ TEST(CreateDenseLkTest, BadInputThrowsRoiflowError) {
 // FlowOptions::initial_flow.
 
 TEST(InitialFlowTest, AUniformFieldEqualsTheInitialMotion) {
-  const Scene s = make_scene(SceneKind::Translation, kSize, 9);
+  const Scene s = make_scene(SceneKind::Translation, kObjectSceneSize, 9);
   const LkParams params = LkParams::paper();
   FlowOptions motion;
   motion.initial_motion = {2.f, -1.f};
-  const int top = flow_pyramid_levels(kSize, params, motion) - 1;
+  const int top = flow_pyramid_levels(kObjectSceneSize, params, motion) - 1;
   FlowOptions field;
-  field.initial_flow =
-      cv::Mat(level_size(kSize, top), CV_32FC2, cv::Scalar(2.f / (1 << top), -1.f / (1 << top)));
-  EXPECT_EQ(max_abs_diff(dense_flow(s.frame0, s.frame1, params, field).flow,
-                         dense_flow(s.frame0, s.frame1, params, motion).flow),
+  field.initial_flow = cv::Mat(level_size(kObjectSceneSize, top), CV_32FC2,
+                               cv::Scalar(2.f / (1 << top), -1.f / (1 << top)));
+  EXPECT_EQ(test::max_abs_diff(dense_flow(s.frame0, s.frame1, params, field).flow,
+                               dense_flow(s.frame0, s.frame1, params, motion).flow),
             0.0);
   // Also for a region: the field is read over the region's rectangle of the coarsest level.
   motion.region = field.region = cv::Rect(40, 30, 60, 40);
-  EXPECT_EQ(max_abs_diff(dense_flow(s.frame0, s.frame1, params, field).flow,
-                         dense_flow(s.frame0, s.frame1, params, motion).flow),
+  EXPECT_EQ(test::max_abs_diff(dense_flow(s.frame0, s.frame1, params, field).flow,
+                               dense_flow(s.frame0, s.frame1, params, motion).flow),
             0.0);
 }
 
@@ -279,7 +273,7 @@ TEST(InitialFlowTest, AFieldReachesMotionsBeyondThePyramid) {
 }
 
 TEST(InitialFlowTest, WrongSizeOrTypeNamesTheExpectedSize) {
-  const Scene s = make_scene(SceneKind::Translation, kSize, 12);
+  const Scene s = make_scene(SceneKind::Translation, kObjectSceneSize, 12);
   const LkParams params = LkParams::paper();  // 3 levels: the coarsest is 40x30
   FlowOptions options;
   options.initial_flow = cv::Mat(31, 40, CV_32FC2, cv::Scalar::all(0));

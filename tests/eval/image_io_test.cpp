@@ -19,10 +19,10 @@ namespace {
 namespace fs = std::filesystem;
 using roiflow::test::error_message;
 
-const cv::Size kSize(64, 48);
+const cv::Size kImageSize(64, 48);
 
 // A textured picture with a bright square.
-cv::Mat scene(cv::Size size = kSize) {
+cv::Mat scene(cv::Size size = kImageSize) {
   cv::Mat image(size, CV_8UC3);
   for (int y = 0; y < size.height; ++y)
     for (int x = 0; x < size.width; ++x)
@@ -71,11 +71,11 @@ TEST_F(ImageIoTest, FrameSizeLimits) {
 TEST_F(ImageIoTest, ReadImageRefusesCutOrDamagedPngAndJpeg) {
   ASSERT_TRUE(cv::imwrite(path("a.png"), scene()));
   ASSERT_TRUE(cv::imwrite(path("a.jpg"), scene()));
-  EXPECT_EQ(read_image(path("a.png"), cv::IMREAD_ANYCOLOR).size(), kSize);
+  EXPECT_EQ(read_image(path("a.png"), cv::IMREAD_ANYCOLOR).size(), kImageSize);
   EXPECT_EQ(read_image(path("a.jpg"), cv::IMREAD_GRAYSCALE).type(), CV_8UC1);
   // Trailing bytes after the end of a JPEG (some cameras append data) are fine.
   write_bytes(path("tail.jpg"), read_bytes(path("a.jpg")) + "trailer");
-  EXPECT_EQ(read_image(path("tail.jpg"), cv::IMREAD_ANYCOLOR).size(), kSize);
+  EXPECT_EQ(read_image(path("tail.jpg"), cv::IMREAD_ANYCOLOR).size(), kImageSize);
 
   const std::string png = read_bytes(path("a.png"));
   const std::string jpg = read_bytes(path("a.jpg"));

@@ -21,7 +21,7 @@ MotBox box(int frame, int id, double x, double y = 0, double w = 10, double h = 
   return b;
 }
 
-MotScore score(const std::vector<MotBox>& pred, const std::vector<MotBox>& gt) {
+MotScore score_boxes(const std::vector<MotBox>& pred, const std::vector<MotBox>& gt) {
   return eval::score_mot(pred, gt);
 }
 
@@ -33,7 +33,7 @@ TEST(MotScore, PerfectTrackWithOtherIdsScoresOne) {
     pred.push_back(box(f, 7, 10.0 * f));
     pred.push_back(box(f, 3, 100, 50));
   }
-  const MotScore s = score(pred, gt);
+  const MotScore s = score_boxes(pred, gt);
   EXPECT_DOUBLE_EQ(s.mota, 1.0);
   EXPECT_DOUBLE_EQ(s.motp, 1.0);
   EXPECT_DOUBLE_EQ(s.idf1, 1.0);
@@ -50,7 +50,7 @@ TEST(MotScore, IdSwitch) {
     gt.push_back(box(f, 1, 0));
     pred.push_back(box(f, f <= 2 ? 10 : 11, 0));
   }
-  const MotScore s = score(pred, gt);
+  const MotScore s = score_boxes(pred, gt);
   EXPECT_EQ(s.id_switches, 1);
   EXPECT_EQ(s.fp, 0);
   EXPECT_EQ(s.fn, 0);
@@ -64,7 +64,7 @@ TEST(MotScore, FalsePositiveAndMiss) {
   // Frame 1 matched at IoU 9/11; frame 2 the tracker box is elsewhere: 1 FN + 1 FP.
   const std::vector<MotBox> gt = {box(1, 1, 0), box(2, 1, 0)};
   const std::vector<MotBox> pred = {box(1, 5, 1), box(2, 5, 50)};
-  const MotScore s = score(pred, gt);
+  const MotScore s = score_boxes(pred, gt);
   EXPECT_EQ(s.fn, 1);
   EXPECT_EQ(s.fp, 1);
   EXPECT_EQ(s.matches, 1);
@@ -76,9 +76,9 @@ TEST(MotScore, FalsePositiveAndMiss) {
 
 TEST(MotScore, IouOfExactlyHalfMatchesAndBelowDoesNot) {
   // 10x10 inside a 20x10 box: IoU = 100 / 200.
-  EXPECT_EQ(score({box(1, 1, 0, 0, 20, 10)}, {box(1, 1, 0)}).matches, 1);
+  EXPECT_EQ(score_boxes({box(1, 1, 0, 0, 20, 10)}, {box(1, 1, 0)}).matches, 1);
   // 10x10 against 10x10 shifted by 4: IoU = 60 / 140 < 0.5.
-  const MotScore s = score({box(1, 1, 4)}, {box(1, 1, 0)});
+  const MotScore s = score_boxes({box(1, 1, 4)}, {box(1, 1, 0)});
   EXPECT_EQ(s.matches, 0);
   EXPECT_EQ(s.fp, 1);
   EXPECT_EQ(s.fn, 1);
@@ -91,7 +91,7 @@ TEST(MotScore, CrossingKeepsPreviousCorrespondenceWhileItHolds) {
   // B-1 (9/11): two switches. But A-1 (IoU 7/13) and B-2 (8/12) still hold, so they are kept.
   const std::vector<MotBox> gt = {box(1, 1, 0), box(1, 2, 20), box(2, 1, 0), box(2, 2, 2)};
   const std::vector<MotBox> pred = {box(1, 1, 0), box(1, 2, 20), box(2, 1, 3), box(2, 2, 0)};
-  const MotScore s = score(pred, gt);
+  const MotScore s = score_boxes(pred, gt);
   EXPECT_EQ(s.id_switches, 0);
   EXPECT_EQ(s.matches, 4);
   EXPECT_NEAR(s.motp, (1 + 1 + 7.0 / 13.0 + 8.0 / 12.0) / 4, 1e-12);
@@ -107,7 +107,7 @@ TEST(MotScore, CrossingWithSwappedIdsCountsTwoSwitches) {
     pred.push_back(box(f, f <= 3 ? 1 : 2, a));
     pred.push_back(box(f, f <= 3 ? 2 : 1, b, 40));
   }
-  const MotScore s = score(pred, gt);
+  const MotScore s = score_boxes(pred, gt);
   EXPECT_EQ(s.id_switches, 2);
   EXPECT_DOUBLE_EQ(s.mota, 1.0 - 2.0 / 12.0);
   EXPECT_DOUBLE_EQ(s.idf1, 0.5);  // each id pairing covers 3 of 6 frames
@@ -116,7 +116,7 @@ TEST(MotScore, CrossingWithSwappedIdsCountsTwoSwitches) {
 TEST(MotScore, OptimalNotGreedyMatching) {
   // A at 0, B at 3; tracker p at 1 (IoU 9/11 with A, 8/12 with B), q at -3 (7/13 with A only).
   // Greedy by IoU takes A-p and leaves B unmatched; the optimum matches both.
-  const MotScore s = score({box(1, 1, 1), box(1, 2, -3)}, {box(1, 1, 0), box(1, 2, 3)});
+  const MotScore s = score_boxes({box(1, 1, 1), box(1, 2, -3)}, {box(1, 1, 0), box(1, 2, 3)});
   EXPECT_EQ(s.matches, 2);
   EXPECT_EQ(s.fn, 0);
   EXPECT_EQ(s.fp, 0);
@@ -130,7 +130,7 @@ TEST(MotScore, IdF1PairsIdsGlobally) {
     gt.push_back(box(f, f <= 3 ? 1 : 2, 0));
     pred.push_back(box(f, 5, 0));
   }
-  const MotScore s = score(pred, gt);
+  const MotScore s = score_boxes(pred, gt);
   EXPECT_EQ(s.id_switches, 0);
   EXPECT_DOUBLE_EQ(s.mota, 1.0);
   EXPECT_DOUBLE_EQ(s.idf1, 0.5);  // 2 * 3 / (6 + 6)
@@ -155,7 +155,7 @@ MotScore score_frames(const std::vector<Frame>& frames) {
     for (const auto& [h, o] : frames[f].hyps)
       pred.push_back(box(frame, h, o > 0 ? 100.0 * o : 5000.0 + 100 * h));
   }
-  return score(pred, gt);
+  return score_boxes(pred, gt);
 }
 
 TEST(MotScore, AgreesWithPyMotmetricsOwnCases) {
@@ -258,7 +258,7 @@ TEST(MotScore, ConfZeroGroundTruthIsNotScored) {
       "2,2,50,0,10,10,0\n",
       "gt");
   const std::vector<MotBox> pred = {box(1, 1, 0), box(1, 2, 50), box(2, 2, 50)};
-  const MotScore s = score(pred, gt);
+  const MotScore s = score_boxes(pred, gt);
   EXPECT_EQ(s.gt_boxes, 1);
   EXPECT_EQ(s.objects, 1);
   EXPECT_EQ(s.fp, 2);
@@ -276,7 +276,7 @@ TEST(MotScore, ClassColumnsFollowMotChallengePreprocessing) {
       "1,3,100,0,10,10,1,3,1\n",
       "gt");
   const std::vector<MotBox> pred = {box(1, 1, 0), box(1, 2, 51), box(1, 3, 100)};
-  const MotScore s = score(pred, gt);
+  const MotScore s = score_boxes(pred, gt);
   EXPECT_EQ(s.gt_boxes, 1);
   EXPECT_EQ(s.pred_boxes, 2);
   EXPECT_EQ(s.matches, 1);
@@ -285,18 +285,18 @@ TEST(MotScore, ClassColumnsFollowMotChallengePreprocessing) {
   // Ten columns (MOT15 world coordinates): the eighth is not a class, nothing is removed.
   const std::vector<MotBox> mot15 = eval::parse_mot("1,1,0,0,10,10,1,7,-1,-1\n", "gt");
   EXPECT_EQ(mot15[0].object_class, 0);
-  EXPECT_EQ(score({box(1, 4, 0)}, mot15).matches, 1);
+  EXPECT_EQ(score_boxes({box(1, 4, 0)}, mot15).matches, 1);
 }
 
 TEST(MotScore, EmptyGroundTruthThrows) {
-  EXPECT_NE(test::error_message([] { score({box(1, 1, 0)}, {}); }).find("no box"),
+  EXPECT_NE(test::error_message([] { score_boxes({box(1, 1, 0)}, {}); }).find("no box"),
             std::string::npos);
   const auto zero = eval::parse_mot("1,1,0,0,10,10,0\n", "gt");
-  EXPECT_NE(test::error_message([&] { score({}, zero); }).find("no box"), std::string::npos);
+  EXPECT_NE(test::error_message([&] { score_boxes({}, zero); }).find("no box"), std::string::npos);
 }
 
 TEST(MotScore, NoPredictionsIsAllMisses) {
-  const MotScore s = score({}, {box(1, 1, 0), box(2, 1, 0), box(2, 2, 30)});
+  const MotScore s = score_boxes({}, {box(1, 1, 0), box(2, 1, 0), box(2, 2, 30)});
   EXPECT_EQ(s.fn, 3);
   EXPECT_DOUBLE_EQ(s.mota, 0.0);
   EXPECT_DOUBLE_EQ(s.idf1, 0.0);

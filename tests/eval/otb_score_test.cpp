@@ -18,10 +18,6 @@ using eval::iou;
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
-void write_text(const std::string& path, const std::string& text) {
-  std::ofstream(path, std::ios::binary) << text;
-}
-
 // A target drifting right and down, the size of a small OTB car.
 std::vector<cv::Rect2f> moving_box(int frames, cv::Size2f size = {40, 40}) {
   std::vector<cv::Rect2f> boxes;
@@ -30,7 +26,7 @@ std::vector<cv::Rect2f> moving_box(int frames, cv::Size2f size = {40, 40}) {
   return boxes;
 }
 
-std::vector<cv::Rect2f> shifted(std::vector<cv::Rect2f> boxes, cv::Point2f by) {
+std::vector<cv::Rect2f> shifted_boxes(std::vector<cv::Rect2f> boxes, cv::Point2f by) {
   for (cv::Rect2f& box : boxes) {
     box.x += by.x;
     box.y += by.y;
@@ -41,16 +37,16 @@ std::vector<cv::Rect2f> shifted(std::vector<cv::Rect2f> boxes, cv::Point2f by) {
 class OtbScoreTest : public test::TempDirTest {};
 
 TEST_F(OtbScoreTest, GroundTruthMixesCommasTabsAndSpaces) {
-  write_text(path("gt.txt"),
-             "70,51,107,87\r\n"
-             "71\t52\t106\t86\n"
-             "  \t \n"
-             "72 53 105 85\n"
-             "\r\n"
-             "73, 54,104  84\n"
-             "0,0,0,0\n"
-             "NaN,NaN,NaN,NaN\n"
-             "1.5\t,2.25 , 3e1,4");  // no final line end
+  test::write_text(path("gt.txt"),
+                   "70,51,107,87\r\n"
+                   "71\t52\t106\t86\n"
+                   "  \t \n"
+                   "72 53 105 85\n"
+                   "\r\n"
+                   "73, 54,104  84\n"
+                   "0,0,0,0\n"
+                   "NaN,NaN,NaN,NaN\n"
+                   "1.5\t,2.25 , 3e1,4");  // no final line end
   const std::vector<cv::Rect2f> boxes = eval::read_ground_truth(path("gt.txt"));
   ASSERT_EQ(boxes.size(), 7u);
   EXPECT_EQ(boxes[0], cv::Rect2f(70, 51, 107, 87));
@@ -84,7 +80,7 @@ TEST_F(OtbScoreTest, GroundTruthErrorsNameFileLineAndValue) {
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.text);
-    write_text(path("gt.txt"), c.text);
+    test::write_text(path("gt.txt"), c.text);
     const std::string message =
         test::error_message([&] { eval::read_ground_truth(path("gt.txt")); });
     EXPECT_NE(message.find(path("gt.txt")), std::string::npos) << message;
@@ -136,7 +132,7 @@ TEST_F(OtbScoreTest, TrackShiftedBy10Pixels) {
   const std::vector<cv::Rect2f> truth = moving_box(30);
   // 40x40 boxes 10 px apart: overlap 30x40 = 1200, union 3200 - 1200 = 2000, IoU 0.6, which
   // passes the 12 thresholds 0 .. 0.55.
-  const eval::OtbScore s = eval::score(shifted(truth, {10, 0}), truth);
+  const eval::OtbScore s = eval::score(shifted_boxes(truth, {10, 0}), truth);
   EXPECT_DOUBLE_EQ(s.mean_iou, 0.6);
   EXPECT_DOUBLE_EQ(s.auc, 12.0 / 21.0);
   EXPECT_DOUBLE_EQ(s.precision20, 1.0);
@@ -146,12 +142,12 @@ TEST_F(OtbScoreTest, TrackShiftedBy10Pixels) {
 TEST_F(OtbScoreTest, ThresholdsAreStrictForIouAndInclusiveForDistance) {
   const std::vector<cv::Rect2f> truth = moving_box(10, {30, 30});
   // 30x30 boxes 10 px apart: overlap 600, union 1200, IoU exactly 0.5, not above 0.5.
-  const eval::OtbScore half = eval::score(shifted(truth, {0, 10}), truth);
+  const eval::OtbScore half = eval::score(shifted_boxes(truth, {0, 10}), truth);
   EXPECT_DOUBLE_EQ(half.mean_iou, 0.5);
   EXPECT_DOUBLE_EQ(half.auc, 10.0 / 21.0);
   // A 12-16-20 triangle: exactly 20 px counts as precise; a hair more does not.
-  EXPECT_DOUBLE_EQ(eval::score(shifted(truth, {12, 16}), truth).precision20, 1.0);
-  EXPECT_DOUBLE_EQ(eval::score(shifted(truth, {12, 16.25f}), truth).precision20, 0.0);
+  EXPECT_DOUBLE_EQ(eval::score(shifted_boxes(truth, {12, 16}), truth).precision20, 1.0);
+  EXPECT_DOUBLE_EQ(eval::score(shifted_boxes(truth, {12, 16.25f}), truth).precision20, 0.0);
 }
 
 TEST_F(OtbScoreTest, AbsentTargetFramesAreSkipped) {

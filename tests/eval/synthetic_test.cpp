@@ -13,7 +13,7 @@ namespace {
 
 constexpr SceneKind kAllKinds[] = {SceneKind::Translation, SceneKind::Rotation, SceneKind::Zoom,
                                    SceneKind::NonRigid, SceneKind::MovingObject};
-const cv::Size kSize(320, 240);
+const cv::Size kSceneSize(320, 240);
 // For properties that do not need the full size: keeps the suite quick in Debug builds.
 const cv::Size kSmall(160, 120);
 
@@ -116,9 +116,9 @@ TEST_P(SceneTest, TextureHasContrastWithoutSaturation) {
 // better than frame1 itself does, and to within about one grey level.
 TEST_P(SceneTest, GroundTruthAlignsTheFrames) {
   for (const std::uint64_t seed : {1, 7}) {
-    const Scene s = make_scene(GetParam(), kSize, seed);
+    const Scene s = make_scene(GetParam(), kSceneSize, seed);
     const cv::Mat mask = check_mask(s, GetParam());
-    ASSERT_GT(cv::countNonZero(mask), kSize.area() / 2);
+    ASSERT_GT(cv::countNonZero(mask), kSceneSize.area() / 2);
     const double unaligned = mean_abs_difference(s.frame0, s.frame1, mask);
     const double aligned = mean_abs_difference(s.frame0, warp_back(s.frame1, s.flow), mask);
     RecordProperty("unaligned_seed" + std::to_string(seed), std::to_string(unaligned));
@@ -134,7 +134,7 @@ INSTANTIATE_TEST_SUITE_P(AllKinds, SceneTest, testing::ValuesIn(kAllKinds),
                          });
 
 TEST(Synthetic, TranslationFlowIsTheDocumentedConstant) {
-  const Scene s = make_scene(SceneKind::Translation, kSize);
+  const Scene s = make_scene(SceneKind::Translation, kSceneSize);
   cv::Mat channels[2];
   cv::split(s.flow, channels);
   EXPECT_EQ(cv::norm(channels[0] - 1.3f, cv::NORM_INF), 0);
@@ -142,8 +142,8 @@ TEST(Synthetic, TranslationFlowIsTheDocumentedConstant) {
 }
 
 TEST(Synthetic, RotationIsCounterClockwiseOnScreen) {
-  const Scene s = make_scene(SceneKind::Rotation, kSize);
-  const double cx = (kSize.width - 1) / 2.0, cy = (kSize.height - 1) / 2.0;
+  const Scene s = make_scene(SceneKind::Rotation, kSceneSize);
+  const double cx = (kSceneSize.width - 1) / 2.0, cy = (kSceneSize.height - 1) / 2.0;
   // A point 100 px right of the centre: y points down, so counter-clockwise moves it up.
   const int x = static_cast<int>(cx + 100.5), y = static_cast<int>(cy);
   const cv::Vec2f d = s.flow.at<cv::Vec2f>(y, x);
@@ -155,15 +155,15 @@ TEST(Synthetic, RotationIsCounterClockwiseOnScreen) {
 }
 
 TEST(Synthetic, ZoomFlowPointsAwayFromTheCentre) {
-  const Scene s = make_scene(SceneKind::Zoom, kSize);
-  const double cx = (kSize.width - 1) / 2.0, cy = (kSize.height - 1) / 2.0;
+  const Scene s = make_scene(SceneKind::Zoom, kSceneSize);
+  const double cx = (kSceneSize.width - 1) / 2.0, cy = (kSceneSize.height - 1) / 2.0;
   const cv::Vec2f d = s.flow.at<cv::Vec2f>(10, 300);
   EXPECT_NEAR(d[0], 0.04 * (300 - cx), 1e-4);
   EXPECT_NEAR(d[1], 0.04 * (10 - cy), 1e-4);
 }
 
 TEST(Synthetic, NonRigidFlowIsSmoothAndAboutTwoPixels) {
-  const Scene s = make_scene(SceneKind::NonRigid, kSize);
+  const Scene s = make_scene(SceneKind::NonRigid, kSceneSize);
   cv::Mat channels[2];
   cv::split(s.flow, channels);
   for (const cv::Mat& c : channels) {
@@ -182,11 +182,11 @@ TEST(Synthetic, NonRigidFlowIsSmoothAndAboutTwoPixels) {
 }
 
 TEST(Synthetic, MovingObjectCoversAQuarterOfEachSideLeftOfCentre) {
-  const Scene s = make_scene(SceneKind::MovingObject, kSize);
-  cv::Mat object(kSize, CV_8UC1, cv::Scalar(0));
+  const Scene s = make_scene(SceneKind::MovingObject, kSceneSize);
+  cv::Mat object(kSceneSize, CV_8UC1, cv::Scalar(0));
   int background = 0;
-  for (int y = 0; y < kSize.height; ++y) {
-    for (int x = 0; x < kSize.width; ++x) {
+  for (int y = 0; y < kSceneSize.height; ++y) {
+    for (int x = 0; x < kSceneSize.width; ++x) {
       const cv::Vec2f d = s.flow.at<cv::Vec2f>(y, x);
       if (d == cv::Vec2f(3.2f, 1.5f)) object.at<uchar>(y, x) = 1;
       if (d == cv::Vec2f(0.6f, 0.4f)) ++background;
@@ -194,18 +194,18 @@ TEST(Synthetic, MovingObjectCoversAQuarterOfEachSideLeftOfCentre) {
   }
   const cv::Rect r = cv::boundingRect(object);
   EXPECT_EQ(cv::countNonZero(object), r.area());  // a solid rectangle
-  EXPECT_EQ(cv::countNonZero(object) + background, kSize.area());
-  EXPECT_NEAR(r.width, kSize.width / 4, 1);
-  EXPECT_NEAR(r.height, kSize.height / 4, 1);
-  EXPECT_LT(r.x + r.width / 2, kSize.width / 2);
+  EXPECT_EQ(cv::countNonZero(object) + background, kSceneSize.area());
+  EXPECT_NEAR(r.width, kSceneSize.width / 4, 1);
+  EXPECT_NEAR(r.height, kSceneSize.height / 4, 1);
+  EXPECT_LT(r.x + r.width / 2, kSceneSize.width / 2);
 }
 
 TEST(Synthetic, LargeTranslationIsExact) {
   const cv::Point2f motion(-17.25f, 9.5f);
-  const Scene s = make_translation(kSize, motion, 5);
+  const Scene s = make_translation(kSceneSize, motion, 5);
   EXPECT_EQ(s.flow.at<cv::Vec2f>(100, 100), cv::Vec2f(motion.x, motion.y));
-  cv::Mat mask(kSize, CV_8UC1, cv::Scalar(0));
-  mask(cv::Rect(30, 20, kSize.width - 60, kSize.height - 40)).setTo(255);
+  cv::Mat mask(kSceneSize, CV_8UC1, cv::Scalar(0));
+  mask(cv::Rect(30, 20, kSceneSize.width - 60, kSceneSize.height - 40)).setTo(255);
   const double unaligned = mean_abs_difference(s.frame0, s.frame1, mask);
   const double aligned = mean_abs_difference(s.frame0, warp_back(s.frame1, s.flow), mask);
   EXPECT_LT(aligned, 0.25 * unaligned);
@@ -223,9 +223,9 @@ TEST(Synthetic, BadArgumentsThrowNamingTheValue) {
       EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
     }
   }
-  EXPECT_THROW(make_translation(kSize, cv::Point2f(NAN, 0)), roiflow::Error);
+  EXPECT_THROW(make_translation(kSceneSize, cv::Point2f(NAN, 0)), roiflow::Error);
   try {
-    make_translation(kSize, cv::Point2f(0, 9000));
+    make_translation(kSceneSize, cv::Point2f(0, 9000));
     ADD_FAILURE() << "no exception for a 9000 px motion";
   } catch (const roiflow::Error& e) {
     EXPECT_NE(std::string(e.what()).find("9000"), std::string::npos) << e.what();

@@ -13,10 +13,6 @@ namespace {
 using namespace roiflow;
 using eval::TrackRecord;
 
-void write_text(const std::string& path, const std::string& text) {
-  std::ofstream(path, std::ios::binary) << text;
-}
-
 class TrackLogTest : public test::TempDirTest {};
 
 TEST_F(TrackLogTest, ReadsTheIdColumnAndLogsWrittenBeforeIt) {
@@ -48,8 +44,10 @@ TEST_F(TrackLogTest, RowsReadBackAsWritten) {
       eval::track_json_object(r),
       R"({"frame":7,"id":3,"x":1.26,"y":2.0,"w":30.0,"h":40.0,"vx":0.0,"vy":1.5,"mode":"global",)"
       R"("lost":true,"ms":2.5})");
-  const std::vector<TrackRecord> back = eval::parse_track_csv(
-      std::string(eval::kTrackCsvHeader) + "\n" + eval::track_csv_row(r), "memory");
+  std::string csv(eval::kTrackCsvHeader);
+  csv += '\n';
+  csv += eval::track_csv_row(r);
+  const std::vector<TrackRecord> back = eval::parse_track_csv(csv, "memory");
   ASSERT_EQ(back.size(), 1u);
   EXPECT_EQ(back[0].id, 3);
   EXPECT_EQ(back[0].frame, 7);
@@ -64,8 +62,8 @@ TEST_F(TrackLogTest, RowsReadBackAsWritten) {
 }
 
 TEST_F(TrackLogTest, ReaderAcceptsWindowsLineEnds) {
-  write_text(path("t.csv"),
-             "frame,x,y,w,h,vx,vy,mode,lost,ms\r\n1,1.5,2,3,4,0.1,-0.2,local,0,0.5\r\n");
+  test::write_text(path("t.csv"),
+                   "frame,x,y,w,h,vx,vy,mode,lost,ms\r\n1,1.5,2,3,4,0.1,-0.2,local,0,0.5\r\n");
   const std::vector<TrackRecord> records = eval::read_track_csv(path("t.csv"));
   ASSERT_EQ(records.size(), 1u);
   EXPECT_EQ(records[0].box, cv::Rect2f(1.5f, 2, 3, 4));
@@ -100,7 +98,7 @@ TEST_F(TrackLogTest, ReaderErrorsNameFileLineAndValue) {
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.text);
-    write_text(path("t.csv"), c.text);
+    test::write_text(path("t.csv"), c.text);
     const std::string message = test::error_message([&] { eval::read_track_csv(path("t.csv")); });
     EXPECT_EQ(message.rfind(path("t.csv"), 0), 0u) << message;
     EXPECT_NE(message.find(c.expected), std::string::npos) << message;

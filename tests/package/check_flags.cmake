@@ -17,7 +17,9 @@ if(NOT rc EQUAL 0)
 endif()
 file(READ ${WORK_DIR}/compile_commands.json commands)
 string(JSON count LENGTH "${commands}")
-if(count LESS 50)
+# The libraries' files (eval, report, pipeline and the CLI as a few unity sources): a preset that
+# lost a part would fall under this.
+if(count LESS 40)
   message(FATAL_ERROR "package flags: only ${count} compile commands in the package build")
 endif()
 set(kernels 0)
