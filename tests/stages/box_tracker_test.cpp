@@ -14,7 +14,7 @@
 namespace roiflow::stages {
 namespace {
 
-Frame frame_of(const cv::Mat& bgr, long long index) {
+Frame box_frame(const cv::Mat& bgr, long long index) {
   Frame f;
   f.index = index;
   f.image = bgr;
@@ -32,14 +32,14 @@ TEST(BoxTrackerTest, EveryTrackerStartsOnItsBoxAndFollowsASmoothTarget) {
   for (const std::string& name : box_tracker_names()) {
     SCOPED_TRACE(name);
     std::unique_ptr<BoxTracker> t = make_box_tracker(name);
-    const Frame first = frame_of(scene.render(0), 0);
+    const Frame first = box_frame(scene.render(0), 0);
     const BoxUpdate start = t->start(first, bgr_picture(first), scene.box(0));
     EXPECT_FALSE(start.lost);
     EXPECT_GT(eval::iou(start.box, scene.box(0)), 0.9);
     double iou_sum = 0;
     const int frames = 16;
     for (int i = 1; i < frames; ++i) {
-      const Frame f = frame_of(scene.render(i), i);
+      const Frame f = box_frame(scene.render(i), i);
       iou_sum += eval::iou(t->next(f, bgr_picture(f)).box, scene.box(i));
     }
     // A slowly moving, well-textured target on a static background: every tracker follows it
@@ -62,7 +62,7 @@ TEST(BoxTrackerTest, GrayPicturesBecomeBgr) {
   const cv::Mat bgr = bgr_picture(f);
   EXPECT_EQ(bgr.type(), CV_8UC3);
   EXPECT_EQ(bgr.at<cv::Vec3b>(3, 4), cv::Vec3b(77, 77, 77));
-  Frame colour = frame_of(cv::Mat(8, 10, CV_8UC3, cv::Scalar(1, 2, 3)), 0);
+  Frame colour = box_frame(cv::Mat(8, 10, CV_8UC3, cv::Scalar(1, 2, 3)), 0);
   EXPECT_EQ(bgr_picture(colour).data, colour.image.data);  // no copy
 }
 

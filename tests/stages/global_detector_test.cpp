@@ -5,6 +5,7 @@
 #include <opencv2/imgproc.hpp>
 #include <string>
 
+#include "eval/otb_score.hpp"
 #include "eval/tracking_scene.hpp"
 #include "test_util.hpp"
 
@@ -15,12 +16,7 @@ using eval::TrackingScene;
 using eval::TrackingSceneParams;
 using test::error_message;
 
-double iou(const cv::Rect2f& a, const cv::Rect2f& b) {
-  const double common = (a & b).area();
-  return common / (a.area() + b.area() - common);
-}
-
-cv::Mat gray_of(const cv::Mat& bgr) {
+cv::Mat gray_image(const cv::Mat& bgr) {
   cv::Mat gray;
   cv::cvtColor(bgr, gray, cv::COLOR_BGR2GRAY);
   return gray;
@@ -42,7 +38,7 @@ cv::Rect2f draw_decoy(cv::Mat& frame, int i) {
 
 const Detection* overlapping(const std::vector<Detection>& objects, const cv::Rect2f& truth) {
   for (const Detection& d : objects) {
-    if (iou(d.box, truth) > 0.5) return &d;
+    if (eval::iou(d.box, truth) > 0.5) return &d;
   }
   return nullptr;
 }
@@ -56,7 +52,7 @@ TEST(GlobalDetector, FindsTheMovingVehicleAfterWarmup) {
     GlobalDetector detector(params);
     int found = 0;
     for (int i = 0; i < 70; ++i) {
-      const cv::Mat frame = gray ? gray_of(scene.render(i)) : scene.render(i);
+      const cv::Mat frame = gray ? gray_image(scene.render(i)) : scene.render(i);
       detector.observe(frame);
       const std::vector<Detection> objects = detector.moving_objects();
       if (i < params.warmup) {
@@ -70,7 +66,8 @@ TEST(GlobalDetector, FindsTheMovingVehicleAfterWarmup) {
       ASSERT_FALSE(objects.empty()) << "frame " << i;
       const cv::Rect2f truth = scene.box(i);
       const cv::Point2f centre = (truth.tl() + truth.br()) * 0.5f;
-      found += iou(objects[0].box, truth) > 0.75 && cv::norm(objects[0].barycentre - centre) < 6.0;
+      found +=
+          eval::iou(objects[0].box, truth) > 0.75 && cv::norm(objects[0].barycentre - centre) < 6.0;
     }
     // Where the vehicle slows down to ~1 pixel a frame (frames 40-48) the model learns parts
     // of it; in gray, where it contrasts less, more so.
@@ -113,20 +110,20 @@ TEST(GlobalDetector, ReDetectsByAppearanceAnywhereAtAnotherScale) {
     GlobalDetector detector;
     EXPECT_FALSE(detector.has_target());
     const cv::Mat first = scene.render(5);
-    detector.set_target(gray ? gray_of(first) : first, scene.box(5));
+    detector.set_target(gray ? gray_image(first) : first, scene.box(5));
     ASSERT_TRUE(detector.has_target());
     EXPECT_EQ(detector.target_size(), cv::Size2f(scene.box(5).size()));
     // Far to the right and 22 % larger; the search knows nothing of where.
     const int later = p.frames - 5;
     const cv::Mat frame = scene.render(later);
-    const auto found = gray ? detector.find_target(gray_of(frame), {}, {0, 0}, true)
+    const auto found = gray ? detector.find_target(gray_image(frame), {}, {0, 0}, true)
                             : detector.find_target(frame, {}, {0, 0}, true);
     ASSERT_TRUE(found.has_value());
-    EXPECT_GT(iou(found->box, scene.box(later)), 0.8);
+    EXPECT_GT(eval::iou(found->box, scene.box(later)), 0.8);
     EXPECT_GT(found->score, 0.7);
     EXPECT_LE(found->score, 1.0);
     // The gray frame may be given alongside, as the pipeline has it anyway.
-    const auto again = detector.find_target(frame, gray_of(frame), {0, 0}, true);
+    const auto again = detector.find_target(frame, gray_image(frame), {0, 0}, true);
     ASSERT_TRUE(again.has_value());
     EXPECT_NEAR(again->box.x, found->box.x, 0.01);
   }
@@ -144,7 +141,7 @@ TEST(GlobalDetector, SetTargetSizeSteersTheAppearanceScales) {
   EXPECT_EQ(detector.target_size(), scene.box(later).size());
   const auto found = detector.find_target(scene.render(later), {}, {}, true);
   ASSERT_TRUE(found.has_value());
-  EXPECT_GT(iou(found->box, scene.box(later)), 0.7);
+  EXPECT_GT(eval::iou(found->box, scene.box(later)), 0.7);
 }
 
 TEST(GlobalDetector, NothingFoundWithoutTargetOrWhenTheTargetIsAbsent) {
@@ -167,7 +164,7 @@ TEST(GlobalDetector, SignaturePicksTheTargetAmongTwoMovers) {
     const auto frame_at = [&](int i) {
       cv::Mat f = scene.render(i);
       draw_decoy(f, i);
-      return gray ? gray_of(f) : f;
+      return gray ? gray_image(f) : f;
     };
     for (int i = 0; i <= 30; ++i)
       detector.observe(frame_at(i));
@@ -186,7 +183,7 @@ TEST(GlobalDetector, SignaturePicksTheTargetAmongTwoMovers) {
     const auto found =
         detector.find_target(frame_at(60), {}, (decoy.tl() + decoy.br()) * 0.5f, false);
     ASSERT_TRUE(found.has_value());
-    EXPECT_GT(iou(found->box, scene.box(60)), 0.75);
+    EXPECT_GT(eval::iou(found->box, scene.box(60)), 0.75);
     EXPECT_GE(found->score, 0.5);
     EXPECT_LE(found->score, 1.0);
   }

@@ -25,7 +25,7 @@ using eval::iou;
 
 using test::error_message;
 
-eval::TrackingSceneParams small_scene(double jump) {
+eval::TrackingSceneParams jump_scene(double jump) {
   eval::TrackingSceneParams p;
   p.size = cv::Size(320, 240);
   p.object = cv::Size2f(56, 36);
@@ -38,8 +38,8 @@ eval::TrackingSceneParams small_scene(double jump) {
 // as the pipeline does).
 enum class Pyramids { Always, Never, WhenWanted };
 
-TrackerInput input(const Tracker& tracker, const cv::Mat& bgr, long long index,
-                   Pyramids pyramids = Pyramids::Always) {
+TrackerInput tracker_input(const Tracker& tracker, const cv::Mat& bgr, long long index,
+                           Pyramids pyramids = Pyramids::Always) {
   TrackerInput in;
   in.index = index;
   in.image = bgr;
@@ -52,12 +52,12 @@ TrackerInput input(const Tracker& tracker, const cv::Mat& bgr, long long index,
   return in;
 }
 
-std::vector<TrackerOutput> run(const eval::TrackingScene& scene, TrackerParams params,
-                               Pyramids pyramids = Pyramids::Always) {
+std::vector<TrackerOutput> track_scene(const eval::TrackingScene& scene, TrackerParams params,
+                                       Pyramids pyramids = Pyramids::Always) {
   Tracker tracker(params);
   std::vector<TrackerOutput> outs;
   for (int i = 0; i < scene.frames(); ++i)
-    outs.push_back(tracker.process(input(tracker, scene.render(i), i, pyramids)));
+    outs.push_back(tracker.process(tracker_input(tracker, scene.render(i), i, pyramids)));
   EXPECT_EQ(tracker.global_activations(), outs.back().global_activations);
   return outs;
 }
@@ -70,8 +70,8 @@ TrackerParams with_init(const eval::TrackingScene& scene, TrackMode mode = Track
 }
 
 TEST(Tracker, LocalModeFollowsTheObjectWithFewGlobalActivations) {
-  const eval::TrackingScene scene(small_scene(0.0));
-  const std::vector<TrackerOutput> outs = run(scene, with_init(scene));
+  const eval::TrackingScene scene(jump_scene(0.0));
+  const std::vector<TrackerOutput> outs = track_scene(scene, with_init(scene));
   ASSERT_EQ(outs.size(), 60u);
   EXPECT_EQ(outs[0].box, scene.box(0));
   for (const TrackerOutput& o : outs) {
@@ -90,9 +90,9 @@ TEST(Tracker, LocalModeFollowsTheObjectWithFewGlobalActivations) {
 }
 
 TEST(Tracker, GlobalModeCountsOneActivationPerFrame) {
-  const eval::TrackingScene scene(small_scene(60.0));
-  const std::vector<TrackerOutput> global = run(scene, with_init(scene, TrackMode::Global));
-  const std::vector<TrackerOutput> local = run(scene, with_init(scene));
+  const eval::TrackingScene scene(jump_scene(60.0));
+  const std::vector<TrackerOutput> global = track_scene(scene, with_init(scene, TrackMode::Global));
+  const std::vector<TrackerOutput> local = track_scene(scene, with_init(scene));
   for (std::size_t i = 0; i < global.size(); ++i) {
     EXPECT_EQ(global[i].global_activations, static_cast<long long>(i) + 1);
     EXPECT_EQ(global[i].mode, TrackRecord::Mode::Global);
@@ -118,9 +118,9 @@ TEST(Tracker, GlobalModeCountsOneActivationPerFrame) {
 }
 
 TEST(Tracker, AJumpIsLostLocallyAndFoundAgainByAppearance) {
-  const eval::TrackingScene scene(small_scene(60.0));
+  const eval::TrackingScene scene(jump_scene(60.0));
   const int jump = scene.jump_frame();
-  const std::vector<TrackerOutput> outs = run(scene, with_init(scene));
+  const std::vector<TrackerOutput> outs = track_scene(scene, with_init(scene));
   for (int i = 0; i < jump; ++i) {
     EXPECT_EQ(outs[i].mode, TrackRecord::Mode::Local) << "frame " << i;
     EXPECT_EQ(outs[i].global_activations, 0) << "frame " << i;
@@ -140,13 +140,13 @@ TEST(Tracker, AJumpIsLostLocallyAndFoundAgainByAppearance) {
 }
 
 TEST(Tracker, ATargetNowhereToBeSeenIsReportedLostAndCoasts) {
-  const eval::TrackingScene scene(small_scene(0.0));
+  const eval::TrackingScene scene(jump_scene(0.0));
   Tracker tracker(with_init(scene));
   for (int i = 0; i < 10; ++i)
-    tracker.process(input(tracker, scene.render(i), i));
+    tracker.process(tracker_input(tracker, scene.render(i), i));
   const cv::Mat flat(scene.size(), CV_8UC3, cv::Scalar::all(128));
   for (int i = 10; i < 13; ++i) {
-    const TrackerOutput o = tracker.process(input(tracker, flat, i));
+    const TrackerOutput o = tracker.process(tracker_input(tracker, flat, i));
     EXPECT_TRUE(o.has_target);
     EXPECT_TRUE(o.lost) << "frame " << i;
     EXPECT_EQ(o.mode, TrackRecord::Mode::Global);
@@ -155,15 +155,15 @@ TEST(Tracker, ATargetNowhereToBeSeenIsReportedLostAndCoasts) {
     EXPECT_LT(center_error(o.box, scene.box(i)), 10.0) << "frame " << i;
   }
   // Back in view: found again by the global treatment.
-  const TrackerOutput back = tracker.process(input(tracker, scene.render(13), 13));
+  const TrackerOutput back = tracker.process(tracker_input(tracker, scene.render(13), 13));
   EXPECT_FALSE(back.lost);
   EXPECT_LT(center_error(back.box, scene.box(13)), 2.0);
 }
 
 TEST(Tracker, WithoutInitTheMovingObjectIsDetectedThenTrackedLocally) {
-  const eval::TrackingScene scene(small_scene(60.0));
+  const eval::TrackingScene scene(jump_scene(60.0));
   const int jump = scene.jump_frame();
-  const std::vector<TrackerOutput> outs = run(scene, TrackerParams{});
+  const std::vector<TrackerOutput> outs = track_scene(scene, TrackerParams{});
   // The global treatment runs on every frame until the background model shows a moving object.
   std::size_t found = 0;
   while (found < outs.size() && !outs[found].has_target) {
@@ -192,18 +192,18 @@ TEST(Tracker, WithoutInitTheMovingObjectIsDetectedThenTrackedLocally) {
 // its box it is no tracked object any more (lost), where without the rule it would be held on
 // the still picture for ever.
 TEST(Tracker, AnObjectFoundByItsMotionThatStopsIsLostAfterStillFrames) {
-  const eval::TrackingScene scene(small_scene(0.0));
+  const eval::TrackingScene scene(jump_scene(0.0));
   for (const int still_frames : {20, 0}) {
     TrackerParams params;
     params.still_frames = still_frames;
     Tracker tracker(params);
     for (int i = 0; i < 15; ++i)
-      tracker.process(input(tracker, scene.render(i), i));
+      tracker.process(tracker_input(tracker, scene.render(i), i));
     const cv::Mat stopped = scene.render(14);
     int held = 0;  // frames held after the stop, in a row from it
     bool lost = false;
     for (int i = 15; i < 60 && !lost; ++i) {
-      const TrackerOutput o = tracker.process(input(tracker, stopped, i));
+      const TrackerOutput o = tracker.process(tracker_input(tracker, stopped, i));
       ASSERT_TRUE(o.has_target);
       lost = o.lost;
       if (!lost) ++held;
@@ -226,7 +226,7 @@ TEST(Tracker, AnObjectFoundByItsMotionThatStopsIsLostAfterStillFrames) {
 // An object that leaves the view: no box reported held has less than min_side pixels of it in the
 // frame on a side.
 TEST(Tracker, ABoxHuggingTheBorderIsNeverReportedHeld) {
-  const eval::TrackingScene scene(small_scene(0.0));
+  const eval::TrackingScene scene(jump_scene(0.0));
   TrackerParams params = with_init(scene);
   Tracker tracker(params);
   const cv::Rect2f view(0, 0, static_cast<float>(scene.size().width),
@@ -239,7 +239,7 @@ TEST(Tracker, ABoxHuggingTheBorderIsNeverReportedHeld) {
     cv::Mat frame;
     cv::warpAffine(scene.render(i), frame, m, scene.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
                    cv::Scalar::all(128));
-    const TrackerOutput o = tracker.process(input(tracker, frame, i));
+    const TrackerOutput o = tracker.process(tracker_input(tracker, frame, i));
     const cv::Rect2f inside = o.box & view;
     if (!o.lost) {
       EXPECT_GE(std::min(inside.width, inside.height), params.min_side) << "frame " << i;
@@ -268,7 +268,7 @@ struct PanningScene {
 };
 
 TEST(Tracker, AfterAJumpWhileTheCameraPansTheTargetIsFoundByAppearance) {
-  eval::TrackingSceneParams p = small_scene(60.0);
+  eval::TrackingSceneParams p = jump_scene(60.0);
   p.frames = 50;
   p.jump_frame = 40;
   const eval::TrackingScene scene(p);
@@ -276,7 +276,7 @@ TEST(Tracker, AfterAJumpWhileTheCameraPansTheTargetIsFoundByAppearance) {
   Tracker tracker(TrackerParams{});
   int found_again = -1;
   for (int i = 0; i < p.frames; ++i) {
-    const TrackerOutput out = tracker.process(input(tracker, panning.render(i), i));
+    const TrackerOutput out = tracker.process(tracker_input(tracker, panning.render(i), i));
     if (i >= p.jump_frame && found_again < 0 && out.has_target && !out.lost &&
         iou(out.box, panning.box(i)) > 0.5) {
       found_again = i;
@@ -341,22 +341,23 @@ TEST(Tracker, BadParamsThrowNamingTheValue) {
 }
 
 TEST(Tracker, InitOutsideTheFirstFrameThrows) {
-  const eval::TrackingScene scene(small_scene(0.0));
+  const eval::TrackingScene scene(jump_scene(0.0));
   TrackerParams p;
   p.init = cv::Rect2f(400, 300, 30, 30);
   Tracker tracker(p);
-  const std::string m = error_message([&] { tracker.process(input(tracker, scene.render(0), 0)); });
+  const std::string m =
+      error_message([&] { tracker.process(tracker_input(tracker, scene.render(0), 0)); });
   EXPECT_NE(m.find("400"), std::string::npos) << m;
   EXPECT_NE(m.find("320 x 240"), std::string::npos) << m;
 }
 
 TEST(Tracker, FrameSizeChangeThrows) {
-  const eval::TrackingScene scene(small_scene(0.0));
+  const eval::TrackingScene scene(jump_scene(0.0));
   Tracker tracker(with_init(scene));
-  tracker.process(input(tracker, scene.render(0), 0));
+  tracker.process(tracker_input(tracker, scene.render(0), 0));
   cv::Mat larger;
   cv::resize(scene.render(1), larger, cv::Size(400, 300));
-  const std::string m = error_message([&] { tracker.process(input(tracker, larger, 1)); });
+  const std::string m = error_message([&] { tracker.process(tracker_input(tracker, larger, 1)); });
   EXPECT_NE(m.find("400 x 300"), std::string::npos) << m;
   EXPECT_NE(m.find("320 x 240"), std::string::npos) << m;
 }
@@ -364,14 +365,14 @@ TEST(Tracker, FrameSizeChangeThrows) {
 // Whole-frame pyramids only save the tracker work: with them, without them, or only when it
 // wants them, every output is the same.
 TEST(Tracker, TheWholeFramePyramidsNeverChangeTheResult) {
-  const eval::TrackingScene scene(small_scene(48.0));
+  const eval::TrackingScene scene(jump_scene(48.0));
   TrackerParams detect;
   detect.detector.warmup = 2;
   for (const TrackerParams& params :
        {with_init(scene), with_init(scene, TrackMode::Global), detect}) {
-    const std::vector<TrackerOutput> always = run(scene, params);
+    const std::vector<TrackerOutput> always = track_scene(scene, params);
     for (Pyramids p : {Pyramids::Never, Pyramids::WhenWanted}) {
-      const std::vector<TrackerOutput> other = run(scene, params, p);
+      const std::vector<TrackerOutput> other = track_scene(scene, params, p);
       ASSERT_EQ(other.size(), always.size());
       for (std::size_t i = 0; i < always.size(); ++i) {
         EXPECT_EQ(other[i].box, always[i].box) << "frame " << i;
@@ -386,15 +387,15 @@ TEST(Tracker, TheWholeFramePyramidsNeverChangeTheResult) {
 // gives the same result; the tracker asks for colour only on frames of the global treatment and
 // of its background refresh.
 TEST(Tracker, DeferredColourIsMadeOnlyWhenNeededAndChangesNothing) {
-  const eval::TrackingScene scene(small_scene(60.0));
+  const eval::TrackingScene scene(jump_scene(60.0));
   TrackerParams params;
   params.detector.warmup = 2;
-  const std::vector<TrackerOutput> eager = run(scene, params);
+  const std::vector<TrackerOutput> eager = track_scene(scene, params);
   Tracker tracker(params);
   int made = 0;
   long long global_frames = 0;
   for (int i = 0; i < scene.frames(); ++i) {
-    TrackerInput in = input(tracker, scene.render(i), i);
+    TrackerInput in = tracker_input(tracker, scene.render(i), i);
     const cv::Mat bgr = in.image;
     in.image = cv::Mat();
     in.deferred_image = std::make_shared<const DeferredImage>([bgr, &made] {
@@ -419,7 +420,7 @@ TEST(Tracker, DeferredColourIsMadeOnlyWhenNeededAndChangesNothing) {
 }
 
 TEST(Tracker, WantsWholePyramidsOnlyInGlobalModeOrUntilTheTargetIsKnown) {
-  const eval::TrackingScene scene(small_scene(0.0));
+  const eval::TrackingScene scene(jump_scene(0.0));
   Tracker local(with_init(scene));
   Tracker global(with_init(scene, TrackMode::Global));
   TrackerParams detect_params;
@@ -429,9 +430,9 @@ TEST(Tracker, WantsWholePyramidsOnlyInGlobalModeOrUntilTheTargetIsKnown) {
     EXPECT_TRUE(t->wants_pyramid());
   bool found = false;
   for (int i = 0; i < 12; ++i) {
-    local.process(input(local, scene.render(i), i));
-    global.process(input(global, scene.render(i), i));
-    found = detect.process(input(detect, scene.render(i), i)).has_target;
+    local.process(tracker_input(local, scene.render(i), i));
+    global.process(tracker_input(global, scene.render(i), i));
+    found = detect.process(tracker_input(detect, scene.render(i), i)).has_target;
     EXPECT_FALSE(local.wants_pyramid());
     EXPECT_TRUE(global.wants_pyramid());
     EXPECT_EQ(detect.wants_pyramid(), !found) << "frame " << i;
@@ -440,13 +441,13 @@ TEST(Tracker, WantsWholePyramidsOnlyInGlobalModeOrUntilTheTargetIsKnown) {
 }
 
 TEST(Tracker, AWrongPyramidOrColourGrayThrows) {
-  const eval::TrackingScene scene(small_scene(0.0));
+  const eval::TrackingScene scene(jump_scene(0.0));
   Tracker tracker(with_init(scene));
-  TrackerInput in = input(tracker, scene.render(0), 0);
+  TrackerInput in = tracker_input(tracker, scene.render(0), 0);
   in.pyramid = std::make_shared<flow::Pyramid>(flow::build_pyramid(
       cv::Mat(100, 100, CV_8UC1, cv::Scalar(0)), tracker.pyramid_levels(), 0.5));
   EXPECT_NE(error_message([&] { tracker.process(in); }).find("pyramid"), std::string::npos);
-  in = input(tracker, scene.render(0), 0);
+  in = tracker_input(tracker, scene.render(0), 0);
   in.gray = scene.render(0);
   EXPECT_NE(error_message([&] { tracker.process(in); }).find("8UC3"), std::string::npos);
 }
@@ -494,7 +495,7 @@ TEST(Tracker, ALookalikeSeenForOneFrameDoesNotCaptureTheTrack) {
     Tracker tracker(p);
     std::vector<TrackerOutput> outs;
     for (int i = 0; i < 20; ++i)
-      outs.push_back(tracker.process(input(tracker, scene.render(i), i)));
+      outs.push_back(tracker.process(tracker_input(tracker, scene.render(i), i)));
     return outs;
   };
   const std::vector<TrackerOutput> held = outputs(2);

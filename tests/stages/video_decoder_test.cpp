@@ -17,16 +17,16 @@ namespace {
 
 using roiflow::test::error_message;
 
-const cv::Size kSize(160, 120);
+const cv::Size kDecoderSize(160, 120);
 constexpr int kFrames = 12;
 
 // Colourful texture (every channel varies, within 30..220 so that no colour is clipped in the
 // codec's round trip, where the BGR frame's gray would part from the luma) with a light square
 // moving 3 px a frame.
-cv::Mat scene(int k) {
-  cv::Mat image(kSize, CV_8UC3);
-  for (int y = 0; y < kSize.height; ++y)
-    for (int x = 0; x < kSize.width; ++x)
+cv::Mat decoder_frame(int k) {
+  cv::Mat image(kDecoderSize, CV_8UC3);
+  for (int y = 0; y < kDecoderSize.height; ++y)
+    for (int x = 0; x < kDecoderSize.width; ++x)
       image.at<cv::Vec3b>(y, x) = cv::Vec3b(static_cast<uchar>(30 + (x * 7 + y * 3) % 150),
                                             static_cast<uchar>(30 + (x * 2 + y * 5) % 150),
                                             static_cast<uchar>(30 + (y * 11) % 150));
@@ -46,10 +46,10 @@ class VideoDecoderTest : public roiflow::test::TempDirTest,
   std::string write_video() {
     const Codec& codec = GetParam();
     const std::string file = path(codec.file);
-    cv::VideoWriter writer(file, cv::CAP_FFMPEG, codec.fourcc, 25, kSize);
+    cv::VideoWriter writer(file, cv::CAP_FFMPEG, codec.fourcc, 25, kDecoderSize);
     EXPECT_TRUE(writer.isOpened()) << "cannot write " << codec.name;
     for (int k = 0; k < kFrames; ++k)
-      writer.write(scene(k));
+      writer.write(decoder_frame(k));
     return file;
   }
 };
@@ -59,7 +59,7 @@ class VideoDecoderTest : public roiflow::test::TempDirTest,
 // the BGR frame's own gray, within rounding.
 TEST_P(VideoDecoderTest, GrayIsTheBgrFramesGrayAndFramesComeInOrder) {
   VideoDecoder video(write_video());
-  EXPECT_EQ(video.size(), kSize);
+  EXPECT_EQ(video.size(), kDecoderSize);
   EXPECT_DOUBLE_EQ(video.fps(), 25);
   EXPECT_EQ(video.frame_count(), kFrames);
   EXPECT_EQ(video.threads(), 1);  // small frames: one decoder thread
@@ -70,13 +70,13 @@ TEST_P(VideoDecoderTest, GrayIsTheBgrFramesGrayAndFramesComeInOrder) {
   while (video.read(f, failure)) {
     ASSERT_EQ(f.bgr.type(), CV_8UC3);
     ASSERT_EQ(f.gray.type(), CV_8UC1);
-    ASSERT_EQ(f.gray.size(), kSize);
+    ASSERT_EQ(f.gray.size(), kDecoderSize);
     // Near the BGR frame's gray (which differs by swscale's rounding, up to one level biased
     // at full range, and where interpolated chroma overshoots and a colour is clipped), and at
     // least as near the original picture's gray as that one.
     cv::Mat from_bgr, original;
     cv::cvtColor(f.bgr, from_bgr, cv::COLOR_BGR2GRAY);
-    cv::cvtColor(scene(n), original, cv::COLOR_BGR2GRAY);
+    cv::cvtColor(decoder_frame(n), original, cv::COLOR_BGR2GRAY);
     const auto mean_diff = [](const cv::Mat& a, const cv::Mat& b) {
       cv::Mat diff;
       cv::absdiff(a, b, diff);
@@ -87,7 +87,7 @@ TEST_P(VideoDecoderTest, GrayIsTheBgrFramesGrayAndFramesComeInOrder) {
         << GetParam().name << " frame " << n << ": " << mean_diff(f.gray, original) << " vs "
         << mean_diff(from_bgr, original);
     // The square (bright in gray) moved 3 px a frame.
-    const cv::Moments m = cv::moments(f.gray(cv::Rect(0, 40, kSize.width, 20)) > 200, true);
+    const cv::Moments m = cv::moments(f.gray(cv::Rect(0, 40, kDecoderSize.width, 20)) > 200, true);
     ASSERT_GT(m.m00, 0);
     EXPECT_NEAR(m.m10 / m.m00, 10 + 3 * n + 9.5, 1.5) << "frame " << n;
     EXPECT_NEAR(f.timestamp_s, n / 25.0, 0.5 / 25);
@@ -172,7 +172,7 @@ TEST_P(VideoDecoderTest, DeferredBgrEqualsTheEagerOneFromAnyThreadAfterTheDecode
   for (std::size_t i = 0; i < frames.size(); ++i) {
     const cv::Mat& bgr = got[0][i];
     ASSERT_EQ(bgr.type(), CV_8UC3);
-    ASSERT_EQ(bgr.size(), kSize);
+    ASSERT_EQ(bgr.size(), kDecoderSize);
     EXPECT_EQ(cv::norm(bgr, eager_bgr[i], cv::NORM_INF), 0) << "frame " << i;
     EXPECT_EQ(cv::norm(frames[i].gray, eager_gray[i], cv::NORM_INF), 0) << "frame " << i;
     for (int t = 1; t < kThreads; ++t)
@@ -236,9 +236,9 @@ TEST_F(VideoDecoderErrorTest, AskedThreadsAreUsed) {
   const std::string file = path("clip.mp4");
   {
     cv::VideoWriter writer(file, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('m', 'p', '4', 'v'), 25,
-                           kSize);
+                           kDecoderSize);
     for (int k = 0; k < 4; ++k)
-      writer.write(scene(k));
+      writer.write(decoder_frame(k));
   }
   VideoDecoder video(file, 2);
   EXPECT_EQ(video.threads(), 2);

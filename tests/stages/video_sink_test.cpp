@@ -21,10 +21,10 @@ using namespace roiflow;
 using stages::VideoSink;
 namespace fs = std::filesystem;
 
-const cv::Size kSize(96, 64);
+const cv::Size kSinkSize(96, 64);
 
 // A moving bright square on a dark background: something a codec must really encode.
-cv::Mat make_frame(int i, cv::Size size = kSize) {
+cv::Mat make_frame(int i, cv::Size size = kSinkSize) {
   cv::Mat frame(size, CV_8UC3, cv::Scalar(30, 40, 50));
   frame(cv::Rect((i * 5) % (size.width - 16), 20, 16, 16)).setTo(cv::Scalar(200, 220, 240));
   return frame;
@@ -56,7 +56,7 @@ class VideoSinkFormatTest : public VideoSinkTest,
 TEST_P(VideoSinkFormatTest, RoundTripsEveryFrame) {
   const std::string file = path(std::string("out") + GetParam());
   {
-    VideoSink sink(file, 25, kSize);
+    VideoSink sink(file, 25, kSinkSize);
     for (int i = 0; i < 12; ++i)
       sink.write(make_frame(i));
     EXPECT_EQ(sink.frames(), 12);
@@ -65,7 +65,7 @@ TEST_P(VideoSinkFormatTest, RoundTripsEveryFrame) {
   }
   const Decoded decoded = decode(file);
   EXPECT_EQ(decoded.frames, 12);
-  EXPECT_EQ(decoded.size, kSize);
+  EXPECT_EQ(decoded.size, kSinkSize);
 }
 
 // Test names are the extensions without their dot.
@@ -78,7 +78,7 @@ INSTANTIATE_TEST_SUITE_P(VideoSink, VideoSinkFormatTest,
 TEST_F(VideoSinkTest, DestructorLeavesAPlayableFile) {
   for (const char* name : {"interrupted.mp4", "interrupted.avi"}) {
     try {
-      VideoSink sink(path(name), 10, kSize);
+      VideoSink sink(path(name), 10, kSinkSize);
       for (int i = 0; i < 7; ++i)
         sink.write(make_frame(i));
       throw std::runtime_error("the run dies here");
@@ -86,13 +86,13 @@ TEST_F(VideoSinkTest, DestructorLeavesAPlayableFile) {
     }
     const Decoded decoded = decode(path(name));
     EXPECT_EQ(decoded.frames, 7) << name;
-    EXPECT_EQ(decoded.size, kSize) << name;
+    EXPECT_EQ(decoded.size, kSinkSize) << name;
   }
 }
 
 TEST_F(VideoSinkTest, GrayFramesAreConvertedToBgr) {
   {
-    VideoSink sink(path("gray.avi"), 25, kSize);
+    VideoSink sink(path("gray.avi"), 25, kSinkSize);
     cv::Mat gray;
     cv::extractChannel(make_frame(1), gray, 0);
     sink.write(gray);
@@ -103,9 +103,9 @@ TEST_F(VideoSinkTest, GrayFramesAreConvertedToBgr) {
 
 TEST_F(VideoSinkTest, PngFolderHoldsNumberedWholeFrames) {
   const std::string folder = path("frames");
-  VideoSink sink(folder, 25, kSize);
+  VideoSink sink(folder, 25, kSinkSize);
   EXPECT_TRUE(fs::is_directory(folder));
-  cv::Mat gray(kSize, CV_8UC1, cv::Scalar(77));
+  cv::Mat gray(kSinkSize, CV_8UC1, cv::Scalar(77));
   sink.write(make_frame(0));
   sink.write(make_frame(1));
   sink.write(gray);
@@ -131,7 +131,7 @@ TEST_F(VideoSinkTest, EncodedOnOtherThreadsThenWrittenInOrder) {
   // writes them in its own order, whatever order the encodings finished in.
   for (const std::string name : {"frames", "out.avi"}) {
     SCOPED_TRACE(name);
-    VideoSink sink(path(name), 25, kSize);
+    VideoSink sink(path(name), 25, kSinkSize);
     std::vector<cv::Mat> encoded(4);
     std::vector<std::thread> threads;
     for (int i = 3; i >= 0; --i)
@@ -155,7 +155,7 @@ TEST_F(VideoSinkTest, EncodedOnOtherThreadsThenWrittenInOrder) {
     }
   }
   // What encode() made for a folder is not a video frame, and the reverse.
-  VideoSink folder(path("f2"), 25, kSize), video(path("v2.avi"), 25, kSize);
+  VideoSink folder(path("f2"), 25, kSinkSize), video(path("v2.avi"), 25, kSinkSize);
   EXPECT_THROW(video.write_encoded(folder.encode(make_frame(0))), Error);
   EXPECT_THROW(folder.write_encoded(video.encode(make_frame(0))), Error);
   EXPECT_THROW(folder.encode(cv::Mat(32, 32, CV_8UC3, cv::Scalar::all(0))), Error);
@@ -163,12 +163,12 @@ TEST_F(VideoSinkTest, EncodedOnOtherThreadsThenWrittenInOrder) {
 }
 
 TEST_F(VideoSinkTest, TrailingSlashOrExistingDirectoryMeansAFolder) {
-  VideoSink slash(path("out.png") + "/", 25, kSize);
+  VideoSink slash(path("out.png") + "/", 25, kSinkSize);
   slash.write(make_frame(0));
   EXPECT_TRUE(fs::exists(path("out.png/000001.png")));
 
   fs::create_directory(path("run.v2"));
-  VideoSink existing(path("run.v2"), 25, kSize);
+  VideoSink existing(path("run.v2"), 25, kSinkSize);
   existing.write(make_frame(0));
   EXPECT_TRUE(fs::exists(path("run.v2/000001.png")));
   EXPECT_NE(existing.description().find("PNG frames in '" + path("run.v2") + "'"),
@@ -177,20 +177,20 @@ TEST_F(VideoSinkTest, TrailingSlashOrExistingDirectoryMeansAFolder) {
 }
 
 TEST_F(VideoSinkTest, DescriptionNamesPathCodecAndSize) {
-  VideoSink sink(path("a.mp4"), 12.5, kSize);
+  VideoSink sink(path("a.mp4"), 12.5, kSinkSize);
   EXPECT_EQ(sink.description(), "video '" + path("a.mp4") + "' (mp4v, 12.5 fps, 96x64)");
 }
 
 TEST_F(VideoSinkTest, UnknownExtensionThrows) {
   const std::string message =
-      test::error_message([&] { VideoSink sink(path("out.jpg"), 25, kSize); });
+      test::error_message([&] { VideoSink sink(path("out.jpg"), 25, kSinkSize); });
   EXPECT_NE(message.find("'.jpg'"), std::string::npos) << message;
   EXPECT_NE(message.find(path("out.jpg")), std::string::npos) << message;
 }
 
 TEST_F(VideoSinkTest, MissingDirectoryThrowsNamingThePath) {
   const std::string file = path("missing/out.avi");
-  const std::string message = test::error_message([&] { VideoSink sink(file, 25, kSize); });
+  const std::string message = test::error_message([&] { VideoSink sink(file, 25, kSinkSize); });
   EXPECT_NE(message.find(file), std::string::npos) << message;
   EXPECT_FALSE(fs::exists(path("missing")));
 }
@@ -198,12 +198,12 @@ TEST_F(VideoSinkTest, MissingDirectoryThrowsNamingThePath) {
 TEST_F(VideoSinkTest, FolderThatCannotBeCreatedThrows) {
   std::ofstream(path("plain_file")) << "x";
   const std::string folder = path("plain_file/frames");
-  const std::string message = test::error_message([&] { VideoSink sink(folder, 25, kSize); });
+  const std::string message = test::error_message([&] { VideoSink sink(folder, 25, kSinkSize); });
   EXPECT_NE(message.find(folder), std::string::npos) << message;
 }
 
 TEST_F(VideoSinkTest, BadParametersThrow) {
-  EXPECT_NE(test::error_message([&] { VideoSink sink(path("a.avi"), 0, kSize); }).find("fps"),
+  EXPECT_NE(test::error_message([&] { VideoSink sink(path("a.avi"), 0, kSinkSize); }).find("fps"),
             std::string::npos);
   EXPECT_NE(test::error_message([&] {
               VideoSink sink(path("a.avi"), 25, {0, 10});
@@ -213,14 +213,14 @@ TEST_F(VideoSinkTest, BadParametersThrow) {
 
 TEST_F(VideoSinkTest, BadFramesThrowAndWriteNothing) {
   for (const char* name : {"bad.avi", "bad_frames"}) {
-    VideoSink sink(path(name), 25, kSize);
+    VideoSink sink(path(name), 25, kSinkSize);
     sink.write(make_frame(0));
     const std::string wrong_size = test::error_message([&] {
       sink.write(make_frame(1, {64, 96}));
     });
     EXPECT_NE(wrong_size.find("64x96"), std::string::npos) << wrong_size;
     EXPECT_NE(wrong_size.find("96x64"), std::string::npos) << wrong_size;
-    EXPECT_NE(test::error_message([&] { sink.write(cv::Mat(kSize, CV_32FC3)); }).find("32FC3"),
+    EXPECT_NE(test::error_message([&] { sink.write(cv::Mat(kSinkSize, CV_32FC3)); }).find("32FC3"),
               std::string::npos);
     EXPECT_NE(test::error_message([&] { sink.write(cv::Mat()); }).find("empty"), std::string::npos);
     EXPECT_EQ(sink.frames(), 1);
@@ -232,7 +232,7 @@ TEST_F(VideoSinkTest, BadFramesThrowAndWriteNothing) {
 }
 
 TEST_F(VideoSinkTest, MovedSinkKeepsWriting) {
-  VideoSink first(path("moved.avi"), 25, kSize);
+  VideoSink first(path("moved.avi"), 25, kSinkSize);
   first.write(make_frame(0));
   VideoSink second = std::move(first);
   second.write(make_frame(1));

@@ -21,11 +21,11 @@ using roiflow::test::error_message;
 using State = SourceStatus::State;
 
 const cv::Size kSize(64, 48);
-constexpr int kFrames = 10;
+constexpr int kSourceFrames = 10;
 
 // A textured background with a bright square that moves 4 px right per frame, so the order of
 // frames can be read back from the square's position.
-cv::Mat scene(int k, cv::Size size = kSize) {
+cv::Mat source_frame(int k, cv::Size size = kSize) {
   cv::Mat image(size, CV_8UC3);
   for (int y = 0; y < size.height; ++y)
     for (int x = 0; x < size.width; ++x)
@@ -52,7 +52,7 @@ std::string read_bytes(const std::string& path) {
 
 // Everything the source delivers, but never more than `limit` frames: a source that does not
 // end fails the test instead of hanging it.
-std::vector<Frame> read_all(VideoSource& source, int limit = 2 * kFrames) {
+std::vector<Frame> read_all(VideoSource& source, int limit = 2 * kSourceFrames) {
   std::vector<Frame> frames;
   while (static_cast<int>(frames.size()) <= limit) {
     auto frame = source.next();
@@ -88,21 +88,21 @@ void expect_indices(const std::vector<Frame>& frames, long long first, int n) {
 
 class VideoSourceTest : public roiflow::test::TempDirTest {
  protected:
-  std::string write_video(const std::string& name = "clip.avi", int n = kFrames) {
+  std::string write_video(const std::string& name = "clip.avi", int n = kSourceFrames) {
     const std::string file = path(name);
     cv::VideoWriter writer(file, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 25,
                            kSize);
     EXPECT_TRUE(writer.isOpened()) << "this OpenCV build cannot write MJPG into .avi";
     for (int k = 0; k < n; ++k)
-      writer.write(scene(k));
+      writer.write(source_frame(k));
     return file;
   }
 
-  // Frames first..first+n-1 of scene() as dir/<printf(format, number)>, numbers from 1.
-  void write_images(const std::string& dir, const char* format, int n = kFrames) {
+  // Frames first..first+n-1 of source_frame() as dir/<printf(format, number)>, numbers from 1.
+  void write_images(const std::string& dir, const char* format, int n = kSourceFrames) {
     fs::create_directories(path(dir));
     for (int k = 0; k < n; ++k)
-      ASSERT_TRUE(cv::imwrite(image_path(dir, format, k + 1), scene(k)));
+      ASSERT_TRUE(cv::imwrite(image_path(dir, format, k + 1), source_frame(k)));
   }
 
   std::string image_path(const std::string& dir, const char* format, int number) const {
@@ -117,12 +117,12 @@ TEST_F(VideoSourceTest, ReadsVideoFileInOrderWithIncreasingTimestamps) {
   VideoSource source(file);
   EXPECT_EQ(source.size(), kSize);
   EXPECT_DOUBLE_EQ(source.fps(), 25);
-  EXPECT_EQ(source.frame_count_hint(), kFrames);
+  EXPECT_EQ(source.frame_count_hint(), kSourceFrames);
   EXPECT_NE(source.description().find(file), std::string::npos) << source.description();
   EXPECT_EQ(source.status().state, State::kStreaming);
 
   const auto frames = read_all(source);
-  expect_in_order(frames, 0, kFrames);
+  expect_in_order(frames, 0, kSourceFrames);
   for (const Frame& frame : frames) {
     EXPECT_EQ(frame.image.type(), CV_8UC3);
     EXPECT_NEAR(frame.timestamp_s, frame.index / 25.0, 0.5 / 25);
@@ -143,7 +143,7 @@ TEST_F(VideoSourceTest, DeferredColourGivesTheSamePicturesWhenAsked) {
   EXPECT_EQ(deferred.size(), kSize);
   const auto a = read_all(eager);
   const auto b = read_all(deferred);
-  expect_in_order(b, 0, kFrames);
+  expect_in_order(b, 0, kSourceFrames);
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t i = 0; i < a.size(); ++i) {
     EXPECT_TRUE(b[i].image.empty());
@@ -167,12 +167,12 @@ TEST_F(VideoSourceTest, ReadsOtbFolderAtTheGivenFps) {
   write_images("Car/img", "%04d.jpg");
   write_bytes(path("Car/groundtruth_rect.txt"), "1,2,3,4\n");
   VideoSource source(path("Car"), {.fps = 10});
-  EXPECT_EQ(source.frame_count_hint(), kFrames);
+  EXPECT_EQ(source.frame_count_hint(), kSourceFrames);
   EXPECT_DOUBLE_EQ(source.fps(), 10);
   EXPECT_NE(source.description().find("0001.jpg"), std::string::npos) << source.description();
 
   const auto frames = read_all(source);
-  expect_in_order(frames, 0, kFrames);
+  expect_in_order(frames, 0, kSourceFrames);
   for (const Frame& frame : frames)
     EXPECT_DOUBLE_EQ(frame.timestamp_s, frame.index / 10.0);
   EXPECT_EQ(source.status().state, State::kEnded);
@@ -182,7 +182,7 @@ TEST_F(VideoSourceTest, SortsUnpaddedNumbersNumericallyAndKeepsGrayImagesGray) {
   fs::create_directories(path("seq"));
   for (int k = 0; k < 12; ++k) {
     cv::Mat gray;
-    cv::cvtColor(scene(k), gray, cv::COLOR_BGR2GRAY);
+    cv::cvtColor(source_frame(k), gray, cv::COLOR_BGR2GRAY);
     ASSERT_TRUE(cv::imwrite(image_path("seq", "%d.png", k + 1), gray));
   }
   write_bytes(path("seq/notes9.txt"), "not a frame");
@@ -197,8 +197,8 @@ TEST_F(VideoSourceTest, ReadsPrintfPattern) {
   write_images("frames", "f_%03d.png");
   write_images("frames", "other_%03d.png", 2);
   VideoSource source(path("frames/f_%03d.png"));
-  EXPECT_EQ(source.frame_count_hint(), kFrames);
-  expect_in_order(read_all(source), 0, kFrames);
+  EXPECT_EQ(source.frame_count_hint(), kSourceFrames);
+  expect_in_order(read_all(source), 0, kSourceFrames);
   EXPECT_EQ(source.status().state, State::kEnded);
 }
 
@@ -241,8 +241,8 @@ TEST_F(VideoSourceTest, TruncatedVideoThrowsOrStopsEarlyWithAReason) {
   write_bytes(truncated, bytes.substr(0, bytes.size() * 2 / 5));
   try {
     VideoSource source(truncated);
-    const auto frames = read_all(source, kFrames);
-    EXPECT_LT(static_cast<int>(frames.size()), kFrames);
+    const auto frames = read_all(source, kSourceFrames);
+    EXPECT_LT(static_cast<int>(frames.size()), kSourceFrames);
     EXPECT_EQ(source.status().state, State::kStopped);
     EXPECT_NE(source.status().message.find("stopped at frame " + std::to_string(frames.size())),
               std::string::npos)
@@ -277,7 +277,7 @@ TEST_F(VideoSourceTest, CorruptImageStopsThereWithTheReason) {
 
 TEST_F(VideoSourceTest, FrameOfAnotherSizeStopsThereWithTheReason) {
   write_images("seq", "%04d.png");
-  ASSERT_TRUE(cv::imwrite(image_path("seq", "%04d.png", 3), scene(2, cv::Size(32, 24))));
+  ASSERT_TRUE(cv::imwrite(image_path("seq", "%04d.png", 3), source_frame(2, cv::Size(32, 24))));
   VideoSource source(path("seq"));
   expect_in_order(read_all(source), 0, 2);
   EXPECT_EQ(source.status().state, State::kStopped);
@@ -306,7 +306,7 @@ TEST_F(VideoSourceTest, StartAndMaxFramesSelectARange) {
     EXPECT_EQ(cv::norm(frame.gray, all[static_cast<std::size_t>(frame.index)].gray, cv::NORM_INF),
               0);
 
-  const std::string message = error_message([&] { VideoSource s(file, {.start = kFrames}); });
+  const std::string message = error_message([&] { VideoSource s(file, {.start = kSourceFrames}); });
   EXPECT_NE(message.find(file), std::string::npos) << message;
   EXPECT_NE(message.find("start 10"), std::string::npos) << message;
 }
