@@ -79,7 +79,7 @@ TEST(DenseLkObjectTest, CalcEqualsDenseFlowBitForBitAndReusesItsWorkspace) {
 }
 
 TEST(DenseLkObjectTest, WithoutConfidenceTheFlowIsTheSameAndNoConfidenceIsLeft) {
-  const Scene s = make_scene(SceneKind::NonRigid, kSize, 5);
+  const Scene s = make_scene(SceneKind::NonRigid, kObjectSceneSize, 5);
   LkParams fast = LkParams::fast();
   fast.levels = 3;
   std::vector<LkParams> sets = parameter_sets();
@@ -100,7 +100,7 @@ TEST(DenseLkObjectTest, WithoutConfidenceTheFlowIsTheSameAndNoConfidenceIsLeft) 
       off.confidence = false;
       without.confidence = cv::Mat(4, 4, CV_32F, cv::Scalar(1));  // left over from a call before
       lk.calc(s.frame0, s.frame1, without, off);
-      EXPECT_EQ(max_abs_diff(without.flow, with.flow), 0.0) << way.region << way.finest_level;
+      EXPECT_EQ(test::max_abs_diff(without.flow, with.flow), 0.0) << way.region << way.finest_level;
       EXPECT_TRUE(without.confidence.empty());
       EXPECT_EQ(without.region, with.region);
     }
