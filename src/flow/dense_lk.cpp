@@ -212,7 +212,7 @@ bool chain_levels(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkParams& p
     cl.u = &ws.u[l];
     cl.v = &ws.v[l];
     if (l == 0) {
-      cl.confidence = direct ? &result.confidence : &ws.confidence;
+      if (options.confidence) cl.confidence = direct ? &result.confidence : &ws.confidence;
       cl.flow = direct ? &result.flow : nullptr;
     }
   }
@@ -237,6 +237,7 @@ void flow_from_pyramids(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkPar
                 " levels, " + std::to_string(levels) + " needed");
   }
   const std::vector<cv::Rect>& comp = plan.comp;
+  if (!options.confidence) result.confidence.release();
   const SerialExecutor serial;
   const Executor& exec = executor ? *executor : serial;
 
@@ -285,29 +286,33 @@ void flow_from_pyramids(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkPar
     const bool finest = l == plan.finest;
     const int iterations = params.iterations_at(l, plan.finest);
     if (finest && direct) {
-      iterate_level(p, input, ws.u[l], ws.v[l], &result.confidence, iterations, exec, ws.scratch,
-                    &result.flow);
+      iterate_level(p, input, ws.u[l], ws.v[l], options.confidence ? &result.confidence : nullptr,
+                    iterations, exec, ws.scratch, &result.flow);
       result.region = region;
       return;
     }
-    iterate_level(p, input, ws.u[l], ws.v[l], finest ? &ws.confidence : nullptr, iterations, exec,
+    iterate_level(p, input, ws.u[l], ws.v[l],
+                  finest && options.confidence ? &ws.confidence : nullptr, iterations, exec,
                   ws.scratch);
     cv::Mat u = view(ws.u[l], c.size()), v = view(ws.v[l], c.size());
     median_filter(u, v, finest ? params.final_median : params.level_median, exec);
   }
 
   const cv::Rect crop(region.tl() - comp[0].tl(), region.size());
-  const cv::Mat confidence = view(ws.confidence, comp[plan.finest].size());
-  result.confidence.create(crop.size(), CV_32F);
+  const bool conf = options.confidence;
+  const cv::Mat confidence = conf ? view(ws.confidence, comp[plan.finest].size()) : cv::Mat();
+  if (conf) result.confidence.create(crop.size(), CV_32F);
   if (plan.finest > 0) {
     // Level 1's flow upsampled straight onto the region, interleaved (each pixel's value depends
     // only on where it lies, so the region gives level 0's computed rectangle's values there).
     detail::upsample_flow_pair(view(ws.u[1], comp[1].size()), view(ws.v[1], comp[1].size()),
                                comp[1].tl(), region, result.flow, &exec);
-    exec.for_range(0, crop.height, 64, [&](int y0, int y1) {
-      confidence_to_level0(confidence, comp[plan.finest], plan.finest, region, result.confidence,
-                           y0, y1);
-    });
+    if (conf) {
+      exec.for_range(0, crop.height, 64, [&](int y0, int y1) {
+        confidence_to_level0(confidence, comp[plan.finest], plan.finest, region, result.confidence,
+                             y0, y1);
+      });
+    }
     result.region = region;
     return;
   }
@@ -319,7 +324,7 @@ void flow_from_pyramids(const Pyramid& pyr_t, const Pyramid& pyr_t1, const LkPar
     const cv::Mat planes[] = {u(rows), v(rows)};
     cv::Mat out = result.flow(rows);
     cv::merge(planes, 2, out);
-    confidence(crop)(rows).copyTo(result.confidence(rows));
+    if (conf) confidence(crop)(rows).copyTo(result.confidence(rows));
   });
   result.region = region;
 }

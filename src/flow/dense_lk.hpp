@@ -119,6 +119,10 @@ struct FlowOptions {
   // resolution pixels) stays where `levels` put it. A coarser top level instead would grow the
   // context every level reads, in full-resolution pixels, by 2x.
   int finest_level = 0;
+  // Whether result.confidence is computed. false: it is left empty, and the last iteration
+  // skips the eigenvalue (a square root per pixel) and its plane; the flow is the same. The
+  // OpenCV adapter (createDenseLK), whose caller sees only the flow, sets it false.
+  bool confidence = true;
 };
 
 struct FlowResult {

@@ -14,7 +14,7 @@ class DenseLKOpticalFlow final : public cv::DenseOpticalFlow {
   void calc(cv::InputArray i0, cv::InputArray i1, cv::InputOutputArray flow) override {
     const cv::Mat a = i0.getMat(), b = i1.getMat();
     if (flow.isUMat()) {
-      lk_.calc(a, b, result_);
+      lk_.calc(a, b, result_, options_);
       result_.flow.copyTo(flow);
       return;
     }
@@ -22,7 +22,7 @@ class DenseLKOpticalFlow final : public cv::DenseOpticalFlow {
     // loop), as DIS does.
     if (!a.empty()) flow.create(a.size(), CV_32FC2);
     result_.flow = flow.getMat();
-    lk_.calc(a, b, result_);
+    lk_.calc(a, b, result_, options_);
     if (result_.flow.data != flow.getMat().data) result_.flow.copyTo(flow);
     result_.flow.release();
   }
@@ -34,7 +34,15 @@ class DenseLKOpticalFlow final : public cv::DenseOpticalFlow {
 
  private:
   DenseLK lk_;
-  FlowResult result_;  // the confidence buffer, kept across calls
+  FlowResult result_;
+  // The caller sees only the flow: no confidence is computed.
+  FlowOptions options_ = no_confidence();
+
+  static FlowOptions no_confidence() {
+    FlowOptions o;
+    o.confidence = false;
+    return o;
+  }
 };
 
 }  // namespace

@@ -340,9 +340,12 @@ ROIFLOW_INLINE void prefix_out(Native::F sum, Native::F bottom, Native::F top, i
     column = S::nmadd(S::set1(0.5f), S::add(top, bottom), column);
     S::store(col + c * col_stride + x, column);
   }
-  const Native::F ps = S::add(S::prefix(column), carry);
-  S::store(prefix + c * pstride + x, ps);
-  carry = S::last(ps);
+  // The carry is the same in every lane, so lane N - 1 of the sum is the in-vector total plus
+  // the carry: taking the total out of the scan first keeps the lane broadcast off the chain
+  // that runs from vector to vector (the same floats).
+  const Native::F scan = S::prefix(column);
+  S::store(prefix + c * pstride + x, S::add(scan, carry));
+  carry = S::add(S::last(scan), carry);
 }
 
 // Row s enters the window: its factors into the ring slot `ring` (which holds the leaving row's
@@ -453,6 +456,19 @@ struct SolveRow {
   float* flow;  // non-null: (u, v) interleaved here instead of un, vn (rows not padded)
 };
 
+// The window sum p[x + hi] - p[x + lo - 1] from the prefix sums' aligned vectors at x - N
+// (`before`), x and x + N: lanes at_hi of (here, after) less lanes at_lo of (before, here).
+template <class S>
+ROIFLOW_INLINE typename S::F window_sum(typename S::F before, typename S::F here,
+                                        typename S::F after, typename S::I at_hi,
+                                        typename S::I at_lo) {
+  if constexpr (S::kPermute2) {
+    return S::sub(S::permute2(here, after, at_hi), S::permute2(before, here, at_lo));
+  } else {
+    return S::sub(here, before);  // (not called: only with two-vector permutes)
+  }
+}
+
 template <bool kHalf, bool kConfidence, bool kInterleaved>
 void solve_row_t(const SolveRow& q, int x0, int x1) {
   using S = Native;
@@ -472,10 +488,38 @@ void solve_row_t(const SolveRow& q, int x0, int x1) {
   float *un = q.un, *vn = q.vn, *conf = q.conf, *flow = q.flow;
   const int w = q.w;
   const F lambda = S::set1(q.lambda), inv_cy = S::set1(q.inv_cy), half = S::set1(0.5f);
+  // Without half weights and with both window ends less than a vector from the column (always
+  // with two-vector permutes, windows up to 31 wide), the prefix sums at x + hi and x + lo - 1
+  // come from the aligned vectors at x - N, x and x + N, kept in registers from one vector to
+  // the next and permuted: the same floats as the loads N floats long at those columns, each of
+  // which would span two cache lines.
+  constexpr bool kAligned = S::kPermute2 && !kHalf;
+  [[maybe_unused]] F before[kChannels], here[kChannels];
+  [[maybe_unused]] S::I at_hi, at_lo;
+  const bool aligned = kAligned && hi >= 0 && hi < S::N && lo <= 0 && lo > -S::N;
+  if constexpr (kAligned) {
+    if (aligned) {
+      at_hi = S::addi(S::iotai(), S::seti(hi));
+      at_lo = S::addi(S::iotai(), S::seti(S::N + lo - 1));
+      for (int c = 0; c < kChannels; ++c) {
+        before[c] = S::load(p[c] - hi + x0 - S::N);
+        here[c] = S::load(p[c] - hi + x0);
+      }
+    }
+  }
   // Whole vectors: the lanes past w land in the rows' padding.
   for (int x = x0; x < x1; x += S::N) {
     F s[kChannels];
     for (int c = 0; c < kChannels; ++c) {
+      if constexpr (kAligned) {
+        if (aligned) {
+          const F after = S::load(p[c] - hi + x + S::N);
+          s[c] = window_sum<S>(before[c], here[c], after, at_hi, at_lo);
+          before[c] = here[c];
+          here[c] = after;
+          continue;
+        }
+      }
       s[c] = S::sub(S::load(p[c] + x), S::load(p[c] + x - span));
       if constexpr (kHalf) {
         s[c] = S::nmadd(half, S::add(S::load(col[c] + x + lo), S::load(col[c] + x + hi)), s[c]);

@@ -84,6 +84,35 @@ TEST(DenseLkObjectTest, CalcEqualsDenseFlowBitForBitAndReusesItsWorkspace) {
   }
 }
 
+TEST(DenseLkObjectTest, WithoutConfidenceTheFlowIsTheSameAndNoConfidenceIsLeft) {
+  const Scene s = make_scene(SceneKind::NonRigid, kSize, 5);
+  LkParams fast = LkParams::fast();
+  fast.levels = 3;
+  std::vector<LkParams> sets = parameter_sets();
+  sets.push_back(fast);
+  // The whole frame (the last iteration writes the result), a region, and LK stopping at
+  // level 1 (the flow upsampled): each way the result is made.
+  std::vector<FlowOptions> ways(3);
+  ways[1].region = cv::Rect(20, 10, 90, 70);
+  ways[2].finest_level = 1;
+  for (const LkParams& params : sets) {
+    DenseLK lk(params);
+    for (const FlowOptions& way : ways) {
+      FlowResult with, without;
+      lk.calc(s.frame0, s.frame1, with, way);
+      ASSERT_FALSE(with.confidence.empty());
+      EXPECT_EQ(with.confidence.size(), with.flow.size());
+      FlowOptions off = way;
+      off.confidence = false;
+      without.confidence = cv::Mat(4, 4, CV_32F, cv::Scalar(1));  // left over from a call before
+      lk.calc(s.frame0, s.frame1, without, off);
+      EXPECT_EQ(max_abs_diff(without.flow, with.flow), 0.0) << way.region << way.finest_level;
+      EXPECT_TRUE(without.confidence.empty());
+      EXPECT_EQ(without.region, with.region);
+    }
+  }
+}
+
 TEST(DenseLkObjectTest, CollectGarbageFreesTheWorkspaceAndTheNextCallRebuildsIt) {
   const Scene s = make_scene(SceneKind::Rotation, kSize, 5);
   DenseLK lk(LkParams::paper());

@@ -254,6 +254,13 @@ TEST(DenseLkTest, TwoChainsOfBandsGiveTheSerialResultBitForBit) {
             EXPECT_EQ(cv::norm(two.confidence, serial.confidence, cv::NORM_INF), 0.0)
                 << c.name << " " << size << " " << region << " " << static_cast<int>(order);
           }
+          if (order != TwoLanes::Order::InOrder) continue;
+          // Without the confidence the chains give the same flow and leave none.
+          FlowOptions off = options;
+          off.confidence = false;
+          const FlowResult bare = lk.calc(a, b, off);
+          EXPECT_EQ(cv::norm(bare.flow, serial.flow, cv::NORM_INF), 0.0) << c.name << " " << size;
+          EXPECT_TRUE(bare.confidence.empty());
         }
       }
     }
