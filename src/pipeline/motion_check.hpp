@@ -32,6 +32,7 @@ struct MotionCheckParams {
     stages::MotionDetectorParams p;
     p.background_ratio = 0.9;
     p.ghost_frames = 0;  // the model's own foreground: no ghost absorbed
+    p.start_frames = 0;  // nor the background its first frames uncover
     return p;
   }();
   double still_share = 0.02;  // a box with at most this share of moving pixels has none

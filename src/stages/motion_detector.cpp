@@ -34,6 +34,8 @@ void MotionDetectorParams::validate() const {
     fail("join_gap must be in [0, 2], got " + number_text(join_gap));
   if (ghost_frames < 0 || ghost_frames > 100000)
     fail("ghost_frames must be in 0..100000, got " + number_text(ghost_frames));
+  if (start_frames < 0 || start_frames > 100000)
+    fail("start_frames must be in 0..100000, got " + number_text(start_frames));
   if (change_frames < 1 || change_frames > 1000)
     fail("change_frames must be in 1..1000, got " + number_text(change_frames));
   if (!(change_level > 0 && change_level < 255))
@@ -69,6 +71,25 @@ double Foreground::changed_share(const cv::Rect2f& box) const {
   return changed.empty() ? 1.0 : share_of(changed, mask, scale, box);
 }
 
+namespace {
+
+// Per pixel (model resolution): frames in a row it was foreground without changing (ghost
+// absorption); whether it settled during the scene start; whether it is held as background, and
+// the gray level it was absorbed at.
+struct PixelState {
+  cv::Mat quiet, settled, absorbed, absorbed_gray;
+  long long frames = 0;  // frames seen with a change mask
+};
+
+// A neighbourhood that moved less than this (model pixels) since `change_frames` back stood still.
+constexpr double kStillShift = 0.5;
+// A window changed by less than this many times the median window's change did not move.
+constexpr float kNoiseRatio = 9;
+// motion_state's window (7) and its blur's reach (2 on each side).
+constexpr int kReach = 11;
+
+}  // namespace
+
 struct MotionDetector::Impl {
   cv::Ptr<cv::BackgroundSubtractorMOG2> model;
   cv::Size frame_size;
@@ -76,9 +97,7 @@ struct MotionDetector::Impl {
   cv::Mat small, raw;
   std::vector<cv::Mat> grays;  // the last change_frames + 1 gray frames (model resolution), a ring
   long long observed = 0;
-  // Ghost absorption (model resolution): per pixel, frames in a row it was foreground without
-  // changing; whether it is held as background; the gray level it was absorbed at.
-  cv::Mat quiet, absorbed, absorbed_gray;
+  PixelState pixels;
 };
 
 namespace {
@@ -92,21 +111,132 @@ namespace {
 // there) or the model itself calls it background. A moving object always changes somewhere (its
 // leading and trailing edges), so none of its parts is absorbed, however uniform its body.
 // Returns the count of absorbed pixels.
-long long absorb_ghosts(cv::Mat& mask, const cv::Mat& gray, const cv::Mat& changed, int frames,
-                        double level, cv::Mat& quiet, cv::Mat& absorbed, cv::Mat& absorbed_gray) {
-  if (quiet.size() != mask.size()) {
-    quiet = cv::Mat::zeros(mask.size(), CV_16U);
-    absorbed = cv::Mat::zeros(mask.size(), CV_8U);
-    absorbed_gray = cv::Mat::zeros(mask.size(), CV_8U);
+//
+// Motion of each pixel's neighbourhood (7x7) between `old` and `gray`: 2 (moved) where the
+// change is more than a shift of `shift` pixels would make, 1 (stood still) where the
+// neighbourhood is textured in every direction and changed less than that, 0 where it cannot
+// tell (too little texture). With I the image, G its structure tensor over the window and d the
+// shift, the change is sum (grad I . d)^2 = d'Gd >= lambda_min(G) |d|^2: a sum of squared
+// differences under shift^2 lambda_min bounds the shift under `shift` (noise only adds to it, so
+// a noisy or weak texture reads as moved or unknown, never as still).
+cv::Mat motion_state(const cv::Mat& gray, const cv::Mat& old, double shift) {
+  cv::Mat now, before;
+  gray.convertTo(now, CV_32F);
+  old.convertTo(before, CV_32F);
+  cv::GaussianBlur(now, now, {0, 0}, 1.0);
+  cv::GaussianBlur(before, before, {0, 0}, 1.0);
+  cv::Mat ix, iy, d;
+  cv::Sobel(now, ix, CV_32F, 1, 0, 3, 1.0 / 8);
+  cv::Sobel(now, iy, CV_32F, 0, 1, 3, 1.0 / 8);
+  cv::subtract(now, before, d);
+  const cv::Size window(7, 7);
+  cv::Mat sxx, syy, sxy, sdd;
+  cv::boxFilter(ix.mul(ix), sxx, CV_32F, window, {-1, -1}, false);
+  cv::boxFilter(iy.mul(iy), syy, CV_32F, window, {-1, -1}, false);
+  cv::boxFilter(ix.mul(iy), sxy, CV_32F, window, {-1, -1}, false);
+  cv::boxFilter(d.mul(d), sdd, CV_32F, window, {-1, -1}, false);
+  const float floor = static_cast<float>(window.area());  // gradient 1 gray level a pixel
+  const float s2 = static_cast<float>(shift * shift);
+  // The camera's noise: most of a fixed camera's view stands still, so the median change of a
+  // window is noise; a change under kNoiseRatio times that is no motion.
+  std::vector<float> changes(sdd.begin<float>(), sdd.end<float>());
+  const auto middle = changes.begin() + static_cast<std::ptrdiff_t>(changes.size() / 2);
+  std::nth_element(changes.begin(), middle, changes.end());
+  const float noise = kNoiseRatio * std::max(*middle, floor);  // at least 1 gray level
+  cv::Mat state(gray.size(), CV_8U);
+  for (int y = 0; y < state.rows; ++y) {
+    const float* a = sxx.ptr<float>(y);
+    const float* b = syy.ptr<float>(y);
+    const float* c = sxy.ptr<float>(y);
+    const float* e = sdd.ptr<float>(y);
+    std::uint8_t* out = state.ptr<std::uint8_t>(y);
+    for (int x = 0; x < state.cols; ++x) {
+      const float half = 0.5f * (a[x] + b[x]);
+      const float diff = 0.5f * (a[x] - b[x]);
+      const float lmin = half - std::sqrt(diff * diff + c[x] * c[x]);
+      if (e[x] > s2 * std::max(lmin, floor) && e[x] > noise)
+        out[x] = 2;
+      else
+        out[x] = lmin >= floor ? 1 : 0;
+    }
+  }
+  return state;
+}
+
+void split_blob(const cv::Mat& labels, const cv::Mat& mask, int label, cv::Rect box, double valley,
+                double min_part_share, int depth, std::vector<cv::Rect>& out);
+
+// Scene start's fill: the pixels of `moving` (neighbourhood moved, not settled) that the model
+// calls background, inside the boxes of the objects the foreground holds (the uncovered
+// background taken out): the holes where the model learnt the object itself, never beyond it (a
+// shadow, a soft edge, the place it left). Each component of the foreground splits at the
+// valleys of its column profile as detect_objects splits it (two people side by side), and
+// nothing is filled within half a closing of a cut: the fill never bridges two neighbours, however
+// much the background between them changed (it changes as they walk).
+void fill_start_holes(cv::Mat& mask, cv::Mat& moving, const cv::Mat& settled, const cv::Mat& gray,
+                      const cv::Mat& old, double level, const MotionDetectorParams& params) {
+  cv::Mat labels, stats, centroids;
+  const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
+  const int margin = std::max(1, params.close / 2);
+  cv::Mat inside = cv::Mat::zeros(mask.size(), CV_8U);
+  for (int i = 1; i < n; ++i) {
+    const cv::Rect whole(stats.at<int>(i, cv::CC_STAT_LEFT), stats.at<int>(i, cv::CC_STAT_TOP),
+                         stats.at<int>(i, cv::CC_STAT_WIDTH), stats.at<int>(i, cv::CC_STAT_HEIGHT));
+    std::vector<cv::Rect> parts;
+    split_blob(labels, mask, i, whole, params.split_valley, params.split_width, 0, parts);
+    for (const cv::Rect& r : parts) {  // left to right; a side at a cut gives up the margin
+      const int l = r.x > whole.x ? r.x + margin : r.x;
+      const int e = r.br().x < whole.br().x ? r.br().x - margin : r.br().x;
+      if (e > l) inside(cv::Rect(l, r.y, e - l, r.height)).setTo(255);
+    }
+  }
+  moving &= inside;
+  moving.setTo(0, settled);
+  cv::Mat weak;  // and changed itself, by half the change level
+  cv::absdiff(gray, old, weak);
+  cv::threshold(weak, weak, level / 2, 255, cv::THRESH_BINARY);
+  moving &= weak;
+  mask |= moving;
+}
+
+// Scene start (the first `start` frames, > 0): the model learnt its first frame as background,
+// the objects that moved in it included. There, until the pixel is settled: where its
+// neighbourhood moved (motion_state against `old`, less the window's reach) it is foreground
+// whatever the model says (the model holds the object that passed there); a foreground pixel
+// that did not change and whose neighbourhood provably stood still is background such an
+// object uncovered (it does not move; an object's body does, however uniform its colour to the
+// change test): absorbed like a ghost at once, and settled. After the start the model has
+// learnt more than its first frame and every pixel is left to it.
+long long absorb_ghosts(cv::Mat& mask, const cv::Mat& gray, const cv::Mat& old,
+                        const cv::Mat& changed, const MotionDetectorParams& params,
+                        PixelState& st) {
+  const int frames = params.ghost_frames, start_frames = params.start_frames;
+  const double level = params.change_level;
+  if (st.quiet.size() != mask.size()) {
+    st.quiet = cv::Mat::zeros(mask.size(), CV_16U);
+    st.settled = cv::Mat::zeros(mask.size(), CV_8U);
+    st.absorbed = cv::Mat::zeros(mask.size(), CV_8U);
+    st.absorbed_gray = cv::Mat::zeros(mask.size(), CV_8U);
+  }
+  const bool start = ++st.frames <= start_frames;
+  cv::Mat motion, moving;
+  if (start) {
+    motion = motion_state(gray, old, kStillShift);
+    // Where it moved, less the reach of the window and the blur beyond the moving pixels.
+    cv::compare(motion, 2, moving, cv::CMP_EQ);
+    const cv::Mat reach = cv::getStructuringElement(cv::MORPH_RECT, {kReach, kReach});
+    cv::erode(moving, moving, reach);
   }
   const int limit = static_cast<int>(level);
   for (int y = 0; y < mask.rows; ++y) {
     std::uint8_t* m = mask.ptr<std::uint8_t>(y);
     const std::uint8_t* g = gray.ptr<std::uint8_t>(y);
     const std::uint8_t* c = changed.ptr<std::uint8_t>(y);
-    std::uint16_t* q = quiet.ptr<std::uint16_t>(y);
-    std::uint8_t* a = absorbed.ptr<std::uint8_t>(y);
-    const std::uint8_t* ag = absorbed_gray.ptr<std::uint8_t>(y);
+    std::uint16_t* q = st.quiet.ptr<std::uint16_t>(y);
+    std::uint8_t* se = st.settled.ptr<std::uint8_t>(y);
+    std::uint8_t* a = st.absorbed.ptr<std::uint8_t>(y);
+    std::uint8_t* ag = st.absorbed_gray.ptr<std::uint8_t>(y);
+    const std::uint8_t* mv = start ? motion.ptr<std::uint8_t>(y) : nullptr;
     for (int x = 0; x < mask.cols; ++x) {
       if (a[x] != 0) {
         if (m[x] != 0 && std::abs(static_cast<int>(g[x]) - ag[x]) <= limit)
@@ -114,18 +244,26 @@ long long absorb_ghosts(cv::Mat& mask, const cv::Mat& gray, const cv::Mat& chang
         else
           a[x] = 0;
       }
+      if (start && se[x] == 0 && m[x] != 0 && c[x] == 0 && mv[x] == 1) {
+        se[x] = 1;  // absorbed at its gray level
+        a[x] = 1;
+        ag[x] = g[x];
+        m[x] = 0;
+      }
       if (m[x] == 0 || c[x] != 0)
         q[x] = 0;
       else if (q[x] < 65535)
         ++q[x];
     }
   }
+  if (start) fill_start_holes(mask, moving, st.settled, gray, old, level, params);
+  if (frames <= 0) return cv::countNonZero(st.absorbed);
   cv::Mat labels, stats, centroids;
   const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
   std::vector<int> active(static_cast<std::size_t>(n), 0);
   for (int y = 0; y < mask.rows; ++y) {
     const int* l = labels.ptr<int>(y);
-    const std::uint16_t* q = quiet.ptr<std::uint16_t>(y);
+    const std::uint16_t* q = st.quiet.ptr<std::uint16_t>(y);
     for (int x = 0; x < mask.cols; ++x)
       if (l[x] > 0 && q[x] < frames) ++active[static_cast<std::size_t>(l[x])];
   }
@@ -138,9 +276,9 @@ long long absorb_ghosts(cv::Mat& mask, const cv::Mat& gray, const cv::Mat& chang
     std::uint8_t* m = mask.ptr<std::uint8_t>(y);
     const int* l = labels.ptr<int>(y);
     const std::uint8_t* g = gray.ptr<std::uint8_t>(y);
-    std::uint16_t* q = quiet.ptr<std::uint16_t>(y);
-    std::uint8_t* a = absorbed.ptr<std::uint8_t>(y);
-    std::uint8_t* ag = absorbed_gray.ptr<std::uint8_t>(y);
+    std::uint16_t* q = st.quiet.ptr<std::uint16_t>(y);
+    std::uint8_t* a = st.absorbed.ptr<std::uint8_t>(y);
+    std::uint8_t* ag = st.absorbed_gray.ptr<std::uint8_t>(y);
     for (int x = 0; x < mask.cols; ++x) {
       if (a[x] != 0) ++count;
       if (l[x] <= 0 || ghost[static_cast<std::size_t>(l[x])] == 0) continue;
@@ -207,15 +345,16 @@ Foreground MotionDetector::observe(const cv::Mat& image) {
   } else {
     input->copyTo(gray);
   }
-  if (s.observed > params_.change_frames) {
-    const cv::Mat& old = s.grays[static_cast<std::size_t>((s.observed - 1 - params_.change_frames) %
-                                                          static_cast<long long>(ring))];
+  // While fewer frames have been seen, against the first one.
+  const long long back = std::min<long long>(params_.change_frames, s.observed - 1);
+  if (back >= 1) {
+    const cv::Mat& old =
+        s.grays[static_cast<std::size_t>((s.observed - 1 - back) % static_cast<long long>(ring))];
     cv::Mat diff;
     cv::absdiff(gray, old, diff);
     cv::threshold(diff, diff, params_.change_level, 1, cv::THRESH_BINARY);
-    if (params_.ghost_frames > 0) {
-      fg.absorbed = absorb_ghosts(fg.mask, gray, diff, params_.ghost_frames, params_.change_level,
-                                  s.quiet, s.absorbed, s.absorbed_gray);
+    if (params_.ghost_frames > 0 || params_.start_frames > 0) {
+      fg.absorbed = absorb_ghosts(fg.mask, gray, old, diff, params_, s.pixels);
     }
     cv::integral(diff, fg.changed, CV_32S);
   }

@@ -13,7 +13,10 @@
 // `work_width` (shadows are detected and count as background) and returns the frame's
 // foreground mask with its integral image; a part of it that has not changed for
 // `ghost_frames` frames (a ghost, or an object that stopped) is absorbed into the background at
-// once, until its gray level changes. detect_objects() is the global treatment proper and
+// once, until its gray level changes. With `start_frames`, in the first frames (the model learnt
+// its first frame, moving objects included, as background) the motion of each pixel's
+// neighbourhood decides instead: moving is foreground, provably still is background.
+// detect_objects() is the global treatment proper and
 // keeps no state, so a pipeline runs it beside the next frame's refresh: morphology (an opening
 // removes speckle, a closing joins the parts of one object), connected components, the boxes of
 // those of at least `min_area` full-resolution pixels, and a merge of nested or duplicate boxes
@@ -36,6 +39,13 @@ struct MotionDetectorParams {
   int ghost_frames = 8;           // a foreground pixel that has not changed for this many frames
                                   // in a row is a ghost (or a stopped object) and is absorbed into
                                   // the background at once, until its gray level changes; 0 = never
+  int start_frames = 0;           // scene start: the model learns its first frame as background,
+                                  // objects moving in it included; in these first frames a pixel
+                                  // whose neighbourhood moves is foreground inside a foreground
+                                  // part (never across the valley between two), and foreground
+                                  // whose neighbourhood provably stands still is background such
+                                  // an object uncovered (absorbed like a ghost); 0 = none (the
+                                  // default: docs/TRACKING.md, mot7, has what 30 gains and costs)
   double background_ratio = 0.5;  // MOG2's background: its heaviest modes that together hold this
                                   // share of the recent frames, (0, 1]. OpenCV's 0.9 takes for
                                   // background any colour seen 10% of the time: the body of a
@@ -72,7 +82,8 @@ struct Foreground {
   cv::Mat mask;            // CV_8U, 255 = moving (shadows are background)
   cv::Mat integral;        // CV_32S integral of mask / 255
   // CV_32S integral of the pixels (model resolution) whose gray level changed by more than
-  // MotionDetectorParams::change_level since `change_frames` frames back; empty until then.
+  // MotionDetectorParams::change_level since `change_frames` frames back (since the first frame
+  // while fewer were seen); empty in the first frame.
   // The model's foreground also holds ghosts: background that an object uncovered after
   // standing in it (or since the first frame); a ghost does not change.
   cv::Mat changed;

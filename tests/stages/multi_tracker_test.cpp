@@ -8,6 +8,7 @@
 #include <set>
 #include <sstream>
 
+#include "eval/traffic_scene.hpp"
 #include "mot_scene.hpp"
 #include "stages/motion_detector.hpp"
 #include "test_util.hpp"
@@ -176,6 +177,50 @@ TEST(MotionDetector, AbsorbsAGhostIntoTheBackgroundAtOnce) {
   cv::rectangle(frame, cv::Rect(ghost), cv::Scalar(255, 255, 255), cv::FILLED);
   fg = detector.observe(frame);
   EXPECT_GT(fg.moving_share(ghost), 0.5);
+}
+
+TEST(MotionDetector, TheSceneStartFindsVehiclesMovingInTheFirstFrame) {
+  // The model learns the first frame as background, the vehicles driving in it included: without
+  // the scene start a vehicle's body over its own first place is background (a hole that cuts it
+  // into slices) and the place it left is foreground (a ghost joined to it). With it, the motion
+  // of each pixel's neighbourhood decides in the first frames: more vehicles are found whole
+  // (IoU >= 0.5 with their exact boxes) over frames 6..20, and fewer moving pixels lie off every
+  // vehicle (a ghost is absorbed; the fill stays inside the foreground's parts).
+  const eval::TrafficScene scene({.size = {640, 480}, .frames = 21, .objects = 8});
+  int matched[2] = {0, 0};
+  long long stray[2] = {0, 0};  // moving pixels (model resolution) off every vehicle
+  for (const int start : {0, 30}) {
+    stages::MotionDetectorParams p;
+    p.start_frames = start;
+    stages::MotionDetector detector(p);
+    for (int t = 0; t <= 20; ++t) {
+      const stages::Foreground fg = detector.observe(scene.render(t));
+      if (t < 6) continue;
+      const std::vector<stages::Detection> found = stages::detect_objects(fg, p);
+      cv::Mat off(fg.mask.size(), CV_8U, cv::Scalar(255));
+      for (const eval::MotBox& truth : scene.boxes(t)) {
+        const double s = fg.scale;
+        off(cv::Rect(cv::Point(static_cast<int>((truth.box.x - 3) / s),
+                               static_cast<int>((truth.box.y - 3) / s)),
+                     cv::Point(static_cast<int>((truth.box.br().x + 2) / s) + 1,
+                               static_cast<int>((truth.box.br().y + 2) / s) + 1)) &
+            cv::Rect(0, 0, off.cols, off.rows))
+            .setTo(0);
+      }
+      stray[start > 0 ? 1 : 0] += cv::countNonZero(fg.mask & off);
+      for (const eval::MotBox& truth : scene.boxes(t)) {
+        const cv::Rect2f gt(
+            static_cast<float>(truth.box.x - 1), static_cast<float>(truth.box.y - 1),
+            static_cast<float>(truth.box.width), static_cast<float>(truth.box.height));
+        double best = 0;
+        for (const stages::Detection& d : found)
+          best = std::max(best, test::box_iou(d.box, gt));
+        if (best >= 0.5) ++matched[start > 0 ? 1 : 0];
+      }
+    }
+  }
+  EXPECT_GE(matched[1], matched[0] + 6);  // of about 120 vehicle boxes
+  EXPECT_LT(stray[1], stray[0]);          // the ghosts absorbed, nothing filled off the vehicles
 }
 
 TEST(MotionDetector, RejectsBadParamsAndSizeChanges) {
@@ -526,6 +571,9 @@ TEST(MultiTrackerParams, RejectsBadValues) {
   p = {};
   p.detector.ghost_frames = -1;
   EXPECT_NE(test::error_message([&] { p.validate(); }).find("ghost_frames"), std::string::npos);
+  p.detector.ghost_frames = 8;
+  p.detector.start_frames = -1;
+  EXPECT_NE(test::error_message([&] { p.validate(); }).find("start_frames"), std::string::npos);
   p = {};
   p.parked_frames = 0;
   EXPECT_NE(test::error_message([&] { p.validate(); }).find("parked_frames"), std::string::npos);
