@@ -66,7 +66,7 @@ std::string md_cell(const std::string& text) {
 std::string share_text(const BenchmarkRow& r) {
   const double share = r.lost_share();
   if (!std::isfinite(share)) return "- (0 frames)";
-  return fixed_or_nan(share, 2) + " (" + std::to_string(r.zero_iou_lost) + "/" +
+  return fixed(share, 2) + " (" + std::to_string(r.zero_iou_lost) + "/" +
          std::to_string(r.zero_iou) + ")";
 }
 
@@ -292,7 +292,7 @@ std::string format_benchmark_csv(const std::vector<BenchmarkRow>& rows,
            fixed_or_nan(r.precision20, 4) + "," + fixed_or_nan(r.mean_iou, 4) + "," +
            fixed_or_nan(r.fps, 2) + "," + fixed_or_nan(r.cpu_s, 4) + "," + std::to_string(r.lost) +
            "," + std::to_string(r.zero_iou) + "," + std::to_string(r.zero_iou_lost) + "," +
-           (std::isfinite(share) ? fixed_or_nan(share, 4) : std::string()) + "\n";
+           (std::isfinite(share) ? fixed(share, 4) : std::string()) + "\n";
   };
   for (const BenchmarkRow& r : rows)
     line(r);
