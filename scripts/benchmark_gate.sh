@@ -12,7 +12,7 @@ source scripts/gate_lib.sh
 dir=$1
 bin=${2:-build/release}/roiflow
 sequences=8    # Car4 and the seven of SOURCES.md section 4
-min_auc=0.615  # measured: 0.622 (sot4, issue 20: camera retry, finer scale search)
+min_auc=0.645  # measured: 0.651 (sot9, issue 20: a weak look alone is no hold; a held box after a loss needs the colours)
 [[ -d $dir ]] || gate_fail "$dir not found"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT

@@ -330,6 +330,7 @@ LocalResult LocalTracker::Impl::track(const LocalFrame& in) {
     }
     c = a.centre;
     scale = a.size_ratio;
+    r.by_look_alone = flow_failure != LostReason::Found;
   } else if (matched && a.score < params.min_appearance) {
     return lose(r, LostReason::Appearance, predicted_box, in);
   } else if (a.score >= params.trust_appearance && !a.at_edge) {

@@ -143,6 +143,8 @@ struct LocalResult {
   bool background_known = false;  // the ring around the box gave the background's motion
   cv::Point2f background;         // its motion (median flow of the ring), pixels per frame
   double foreground = 0;          // share of the inliers that move unlike the background
+  bool by_look_alone = false;     // held, but the flow failed: the look alone placed the box
+                                  // (its NCC is `appearance`)
 };
 
 class LocalTracker {

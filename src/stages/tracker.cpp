@@ -311,6 +311,7 @@ struct Tracker::Impl {
   void follow(const TrackerInput& frame, TrackerOutput& out, double refresh_weight);
   LostReason self_check(const TrackerInput& frame, const cv::Rect2f& box);
   bool confirm_candidate(const TrackerInput& frame, const cv::Mat& image, TrackerOutput& out);
+  bool held_by_local(const TrackerInput& frame, const LocalResult& r);
   void retry_by_camera(const TrackerInput& frame, const cv::Rect2f& before,
                        cv::Point2f velocity_before, LocalResult& r);
 
@@ -398,6 +399,15 @@ LostReason Tracker::Impl::self_check(const TrackerInput& frame, const cv::Rect2f
   return still_run >= params.still_frames ? LostReason::Still : LostReason::Found;
 }
 
+// check_recovery: whether a box the local treatment holds is the target's. A box placed by a
+// weak look alone (the flow failed) is not; after a loss, one the local treatment holds again is
+// once its colours match the target's (as a re-detection's must).
+bool Tracker::Impl::held_by_local(const TrackerInput& frame, const LocalResult& r) {
+  if (!lost) return !r.by_look_alone || r.appearance >= params.local.confident_appearance;
+  return params.colour_verify <= -1 ||
+         detector.colour_similarity(frame.picture(), r.box) >= params.colour_verify;
+}
+
 // A provisional re-detection (confirm_frames) is followed by its own look and checked again;
 // true when that confirms it (the target is placed there, `out` says so).
 bool Tracker::Impl::confirm_candidate(const TrackerInput& frame, const cv::Mat& image,
@@ -473,7 +483,10 @@ void Tracker::Impl::follow(const TrackerInput& frame, TrackerOutput& out, double
     if (bg >= 0) camera_moves = bg > params.camera_motion;
   }
   out.reason = r.reason;
-  const LostReason self = r.lost ? r.reason : self_check(frame, r.box);
+  LostReason self = r.lost ? r.reason : self_check(frame, r.box);
+  if (self == LostReason::Found && params.check_recovery && !held_by_local(frame, r)) {
+    self = LostReason::Searching;
+  }
   if (self != r.reason) out.reason = self;
   if (self == LostReason::Found) {
     lost = false;

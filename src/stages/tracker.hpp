@@ -97,6 +97,13 @@ struct TrackerParams {
   // 1..100.
   int confirm_frames = 2;
   double confirm_verify = 0.5;  // [-1, 1]
+  // A box the local treatment placed by its look alone (the flow failed: a camera jump, an
+  // occlusion) with a look short of local.confident_appearance is not taken for the target: a
+  // person or car next to it matches about as well. The target is reported lost, the box stays
+  // where the look put it, and, as after any loss, a box the local treatment holds again is taken
+  // for the target only once its colours match one of the target's colour looks (colour_verify),
+  // as a re-detection's must. false: the local treatment's word is taken as it is.
+  bool check_recovery = true;
   // A held box whose part inside the frame is narrower or lower than this is lost (a box that
   // collapsed, or hugs the border with the object outside the view), pixels, [0, 1000].
   double min_side = 8;

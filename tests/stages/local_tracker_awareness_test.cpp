@@ -239,5 +239,21 @@ TEST(TrackerAwareness, AHiddenTargetIsLostThenFoundAgain) {
   }
 }
 
+TEST(LocalTrackerAwareness, AFlashOfLightIsBridgedByTheLookAlone) {
+  const eval::TrackingScene scene(scene_params({56.f, 36.f}, 0.0));
+  const int flash = 20;
+  LocalTracker tracker;
+  tracker.start({gray_of(scene.render(0)), nullptr}, scene.box(0));
+  for (int i = 1; i < 30; ++i) {
+    cv::Mat f = scene.render(i);
+    // LK's brightness constancy breaks on the flash (and back from it); the looks' NCC does not.
+    if (i == flash) f.convertTo(f, -1, 0.3, 0.7 * 128);
+    const LocalResult r = tracker.track({gray_of(f), nullptr});
+    EXPECT_FALSE(r.lost) << "frame " << i;
+    EXPECT_EQ(r.by_look_alone, i == flash || i == flash + 1) << "frame " << i;
+    EXPECT_GT(iou(r.box, scene.box(i)), 0.9) << "frame " << i;  // measured >= 0.98
+  }
+}
+
 }  // namespace
 }  // namespace roiflow::stages

@@ -512,5 +512,52 @@ TEST(Tracker, ALookalikeSeenForOneFrameDoesNotCaptureTheTrack) {
   EXPECT_GT(iou(at_once[d].box, scene.box(d) + cv::Point2f(50.f, 0.f)), 0.7);
 }
 
+// A flash of light on one frame breaks LK's brightness constancy (the flow fails) but not the
+// NCC of the target's looks: the local treatment places the box by its look alone.
+cv::Mat flashed(const eval::TrackingScene& scene, int i, int flash) {
+  cv::Mat f = scene.render(i);
+  if (i == flash) f.convertTo(f, -1, 0.3, 0.7 * 128);
+  return f;
+}
+
+TEST(Tracker, ABoxPlacedByAWeakLookAloneIsReportedLostUntilItsColoursMatch) {
+  eval::TrackingSceneParams sp = jump_scene(0.0);
+  sp.frames = 30;
+  const eval::TrackingScene scene(sp);
+  const int flash = 20;
+  const auto outputs = [&](bool check) {
+    TrackerParams p = with_init(scene);
+    // Every look counts as weak here (the scene's matches reach NCC ~0.98).
+    p.local.confident_appearance = 0.999;
+    p.check_recovery = check;
+    Tracker tracker(p);
+    std::vector<TrackerOutput> outs;
+    for (int i = 0; i < scene.frames(); ++i) {
+      TrackerInput in;
+      in.index = i;
+      in.image = flashed(scene, i, flash);
+      cv::cvtColor(in.image, in.gray, cv::COLOR_BGR2GRAY);
+      outs.push_back(tracker.process(in));
+    }
+    return outs;
+  };
+  const std::vector<TrackerOutput> checked = outputs(true);
+  for (int i = 0; i < flash; ++i)
+    EXPECT_FALSE(checked[i].lost) << "frame " << i;
+  // The box goes where the look put it (here, the target), but it is not reported found.
+  EXPECT_TRUE(checked[flash].lost);
+  EXPECT_EQ(checked[flash].reason, LostReason::Searching);
+  EXPECT_GT(iou(checked[flash].box, scene.box(flash)), 0.9);  // measured 0.99
+  // The light is back: the box the local treatment holds has the target's colours, and is
+  // taken again.
+  for (int i = flash + 2; i < scene.frames(); ++i) {
+    EXPECT_FALSE(checked[i].lost) << "frame " << i;
+    EXPECT_GT(iou(checked[i].box, scene.box(i)), 0.9) << "frame " << i;
+  }
+  // Without the check the look alone is taken for the target (the baseline this guards against).
+  const std::vector<TrackerOutput> unchecked = outputs(false);
+  EXPECT_FALSE(unchecked[flash].lost);
+}
+
 }  // namespace
 }  // namespace roiflow::stages
