@@ -102,6 +102,16 @@ void upsample_row(const LkKernels& k, const cv::Mat& src, cv::Point origin, cons
   const int twice_y = dst.y + y - 2 * origin.y;
   const int y0 = std::clamp(twice_y >> 1, 0, src.rows - 1);
   const int y1 = std::min(y0 + 1, src.rows - 1);
+  // The coarser level was written a whole level ago and has left the nearer caches: the coarse
+  // row two rows on (first read two finer rows later) is asked for now, so that its loads do not
+  // wait on memory then. (Inline: GCC drops the calls of a function that only prefetches.)
+  if ((twice_y & 1) == 0 && y0 + 2 < src.rows) {
+    const char* next = reinterpret_cast<const char*>(src.ptr<float>(y0 + 2));
+    const std::size_t bytes = static_cast<std::size_t>(src.cols) * sizeof(float);
+    for (std::size_t i = 0; i < bytes; i += 64)
+      __builtin_prefetch(next + i);
+    __builtin_prefetch(next + bytes - 1);
+  }
   k.upsample_row(src.ptr<float>(y0), src.ptr<float>(y1), (twice_y & 1) ? 0.5f : 0.f, src.cols,
                  twice_x >> 1, (twice_x & 1) != 0, dst.width, temp, out);
 }

@@ -16,42 +16,61 @@ namespace {
 // y0 + 1 (or y0 again), fy in {0, 1/2}; n coarse pixels; the finer row starts at coarse pixel k0
 // (between two coarse pixels when `between`) and is `width` long. Pixel x of the finer level sits
 // at x / 2 of the coarser one, so the finer pixels alternate between copies of a coarse pixel and
-// means of two neighbours (borders replicate), all doubled. `temp`: 2 * (n + 2) + 2 * lanes floats.
-void upsample_row(const float* a, const float* b, float fy, int n, int k0, bool between, int width,
-                  float* temp, float* out) {
+// means of two neighbours (borders replicate), all doubled. Coarse pixels j and j + 1 come
+// straight from a and b for every pair of output vectors (no row of copies stored and read back
+// one column off). `temp` is not used (kept for the table's signature).
+template <class S>
+ROIFLOW_INLINE typename S::F upsampled_coarse(const float* a, const float* b, typename S::F fy) {
+  const typename S::F va = S::load(a);
+  return S::mul(S::set1(2.f), S::madd(fy, S::sub(S::load(b), va), va));
+}
+
+template <bool kBetween>
+void upsample_row_t(const float* a, const float* b, float fy, int n, int k0, int width,
+                    float* out) {
   using S = Native;
   using F = S::F;
   constexpr int N = S::N;
-  float* copy = temp;
-  float* mean = temp + round_up(n + 2, N) + N;
-  const F two = S::set1(2.f), half = S::set1(0.5f), vfy = S::set1(fy);
-  int x = 0;
-  for (; x + N <= n; x += N) {
-    const F va = S::load(a + x);
-    S::store(copy + x, S::mul(two, S::madd(vfy, S::sub(S::load(b + x), va), va)));
-  }
-  for (; x < n; ++x)
-    copy[x] = 2.f * Scalar::madd(fy, b[x] - a[x], a[x]);
-  copy[n] = copy[n + 1] = copy[n - 1];
-  for (x = 0; x + N <= n + 1; x += N)
-    S::store(mean + x, S::mul(half, S::add(S::load(copy + x), S::load(copy + x + 1))));
-  for (; x <= n; ++x)
-    mean[x] = 0.5f * (copy[x] + copy[x + 1]);
-  const float* first = between ? mean + k0 : copy + k0;
-  const float* second = between ? copy + k0 + 1 : mean + k0;
+  const F vfy = S::set1(fy), half = S::set1(0.5f);
   const int pairs = width / 2;
   int i = 0;
-  for (; i + N <= pairs; i += N) {
+  // Vectors whose coarse pixels k0 + i .. k0 + i + N all lie in the row.
+  for (; i + N <= pairs && k0 + i + N < n; i += N) {
+    const F c0 = upsampled_coarse<S>(a + k0 + i, b + k0 + i, vfy);
+    const F c1 = upsampled_coarse<S>(a + k0 + i + 1, b + k0 + i + 1, vfy);
+    const F mean = S::mul(half, S::add(c0, c1));
     F lo, hi;
-    S::zip(S::load(first + i), S::load(second + i), lo, hi);
+    if constexpr (kBetween) {
+      S::zip(mean, c1, lo, hi);
+    } else {
+      S::zip(c0, mean, lo, hi);
+    }
     S::store(out + 2 * i, lo);
     S::store(out + 2 * i + N, hi);
   }
-  for (; i < pairs; ++i) {
-    out[2 * i] = first[i];
-    out[2 * i + 1] = second[i];
+  // The rest lane by lane, the last coarse pixel replicated past the row's end.
+  auto coarse = [&](int j) {
+    j = imin(j, n - 1);
+    return upsampled_coarse<Scalar>(a + j, b + j, fy);
+  };
+  for (; i <= pairs; ++i) {
+    const int j = k0 + i;
+    const float c0 = coarse(j), c1 = coarse(j + 1);
+    const float mean = 0.5f * (c0 + c1);
+    const float first = kBetween ? mean : c0;
+    if (i < pairs) {
+      out[2 * i] = first;
+      out[2 * i + 1] = kBetween ? c1 : mean;
+    } else if (width & 1) {
+      out[width - 1] = first;
+    }
   }
-  if (width & 1) out[width - 1] = first[pairs];
+}
+
+void upsample_row(const float* a, const float* b, float fy, int n, int k0, bool between, int width,
+                  float* /*temp*/, float* out) {
+  if (between) return upsample_row_t<true>(a, b, fy, n, k0, width, out);
+  upsample_row_t<false>(a, b, fy, n, k0, width, out);
 }
 
 // 8-bit row to floats in [0, 1].

@@ -191,6 +191,55 @@ TEST(LkKernelsTest, TheBestKindForThisCpu) {
   EXPECT_GE(kinds[n - 1]->lanes, 1);
 }
 
+// Every kind's x2 upsampling of a flow row (vector body, lane-by-lane tail, replicated last
+// pixel, odd widths, both phases) against the rule written out pixel by pixel: bit for bit,
+// since with fy in {0, 1/2} every step is exact or one rounding, fused or not.
+TEST(LkKernelsTest, UpsampleRowOfEveryKindFollowsTheRule) {
+  const detail::LkKernels* kinds[8];
+  const int count = detail::available_lk_kernels(kinds, 8);
+  cv::RNG rng(7);
+  for (int n : {1, 2, 5, 17, 40, 83}) {
+    std::vector<float> a(n), b(n);
+    for (int j = 0; j < n; ++j) {
+      a[j] = static_cast<float>(rng.uniform(-20.0, 20.0));
+      b[j] = static_cast<float>(rng.uniform(-20.0, 20.0));
+    }
+    for (const float fy : {0.f, 0.5f}) {
+      auto coarse = [&](int j) {
+        j = std::min(j, n - 1);
+        return 2.f * (a[j] + fy * (b[j] - a[j]));
+      };
+      for (int k0 = 0; k0 < std::min(n, 3); ++k0) {
+        for (const bool between : {false, true}) {
+          // The finer row ends at most one coarse pixel past the row (as a level's does).
+          const int widest = 2 * (n - k0) + (between ? 0 : 1);
+          for (int width : {1, 2, 3, widest - 1, widest}) {
+            if (width < 1 || width > widest) continue;
+            std::vector<float> want(width);
+            for (int x = 0; x < width; ++x) {
+              const int i = x / 2, j = k0 + i;
+              const float mean = 0.5f * (coarse(j) + coarse(j + 1));
+              const bool odd = (x & 1) != 0;
+              want[x] = between ? (odd ? coarse(j + 1) : mean) : (odd ? mean : coarse(j));
+            }
+            for (int k = 0; k < count; ++k) {
+              std::vector<float> temp(detail::upsample_temp_floats(n)), out(width + 64, -1.f);
+              kinds[k]->upsample_row(a.data(), b.data(), fy, n, k0, between, width, temp.data(),
+                                     out.data());
+              for (int x = 0; x < width; ++x) {
+                ASSERT_EQ(out[x], want[x])
+                    << kinds[k]->name << " n " << n << " fy " << fy << " k0 " << k0 << " between "
+                    << between << " width " << width << " x " << x;
+              }
+              EXPECT_EQ(out[width], -1.f) << kinds[k]->name << ": wrote past the row";
+            }
+          }
+        }
+      }
+    }
+  }
+}
+
 TEST(DenseLkTest, RegionOutsideTheFrameThrows) {
   const cv::Mat frame0 = texture({160, 120}, 2), frame1 = texture({160, 120}, 3);
   for (const cv::Rect region : {cv::Rect(160, 0, 10, 10), cv::Rect(-30, -30, 30, 30),
