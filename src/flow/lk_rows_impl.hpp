@@ -94,8 +94,13 @@ ROIFLOW_INLINE typename S::F filter_h(const float* p, const float* k, int x) {
   return acc;
 }
 
+// (The taps and row pointers are copied to locals first: `t` is a float pointer too, and the
+// compiler would otherwise reload every tap after each store.)
 template <int R>
-void smooth_h_t(const float* p, const float* k, int w, float* t) {
+void smooth_h_t(const float* p, const float* k_in, int w, float* t) {
+  float k[R + 1];
+  for (int j = 0; j <= R; ++j)
+    k[j] = k_in[j];
   int x = 0;
   for (; x + Native::N <= w; x += Native::N)
     Native::store(t + x, filter_h<R, Native>(p, k, x));
@@ -113,7 +118,13 @@ ROIFLOW_INLINE typename S::F filter_v(const float* const* rows, const float* k, 
 }
 
 template <int R>
-void smooth_v_t(const float* const* rows, const float* k, int w, float* o) {
+void smooth_v_t(const float* const* rows_in, const float* k_in, int w, float* o) {
+  float k[R + 1];
+  const float* rows[2 * R + 1];
+  for (int j = 0; j <= R; ++j)
+    k[j] = k_in[j];
+  for (int j = 0; j <= 2 * R; ++j)
+    rows[j] = rows_in[j];
   int x = 0;
   for (; x + Native::N <= w; x += Native::N)
     Native::store(o + x, filter_v<R, Native>(rows, k, x));
