@@ -115,10 +115,13 @@ namespace {
 // Motion of each pixel's neighbourhood (7x7) between `old` and `gray`: 2 (moved) where the
 // change is more than a shift of `shift` pixels would make, 1 (stood still) where the
 // neighbourhood is textured in every direction and changed less than that, 0 where it cannot
-// tell (too little texture). With I the image, G its structure tensor over the window and d the
-// shift, the change is sum (grad I . d)^2 = d'Gd >= lambda_min(G) |d|^2: a sum of squared
-// differences under shift^2 lambda_min bounds the shift under `shift` (noise only adds to it, so
-// a noisy or weak texture reads as moved or unknown, never as still).
+// tell (too little texture, or a change above that bound but within the camera's noise: it
+// proves neither). With I the image, G its structure tensor over the window and d the shift, the
+// change is sum (grad I . d)^2 = d'Gd >= lambda_min(G) |d|^2: a sum of squared differences under
+// shift^2 lambda_min bounds the shift under `shift` (noise only adds to it, so a noisy or weak
+// texture reads as moved or unknown, never as still). Only the bound proves stillness: a weakly
+// textured body that moved 10 px changes by more than the bound but less than the noise guard,
+// and read as still it was absorbed (a moving object's box shrank).
 cv::Mat motion_state(const cv::Mat& gray, const cv::Mat& old, double shift) {
   cv::Mat now, before;
   gray.convertTo(now, CV_32F);
@@ -156,8 +159,10 @@ cv::Mat motion_state(const cv::Mat& gray, const cv::Mat& old, double shift) {
       const float lmin = half - std::sqrt(diff * diff + c[x] * c[x]);
       if (e[x] > s2 * std::max(lmin, floor) && e[x] > noise)
         out[x] = 2;
+      else if (lmin >= floor && e[x] <= s2 * lmin)
+        out[x] = 1;
       else
-        out[x] = lmin >= floor ? 1 : 0;
+        out[x] = 0;  // a change too small for the camera's noise proves no stillness either
     }
   }
   return state;

@@ -39,13 +39,14 @@ struct MotionDetectorParams {
   int ghost_frames = 8;           // a foreground pixel that has not changed for this many frames
                                   // in a row is a ghost (or a stopped object) and is absorbed into
                                   // the background at once, until its gray level changes; 0 = never
-  int start_frames = 0;           // scene start: the model learns its first frame as background,
+  int start_frames = 30;          // scene start: the model learns its first frame as background,
                                   // objects moving in it included; in these first frames a pixel
                                   // whose neighbourhood moves is foreground inside a foreground
                                   // part (never across the valley between two), and foreground
                                   // whose neighbourhood provably stands still is background such
-                                  // an object uncovered (absorbed like a ghost); 0 = none (the
-                                  // default: docs/TRACKING.md, mot7, has what 30 gains and costs)
+                                  // an object uncovered (absorbed like a ghost); 0 = none. About a
+                                  // second of video: by then the model (learning at 1/frames
+                                  // early on) weighs its first frame under 1/30
   double background_ratio = 0.5;  // MOG2's background: its heaviest modes that together hold this
                                   // share of the recent frames, (0, 1]. OpenCV's 0.9 takes for
                                   // background any colour seen 10% of the time: the body of a
