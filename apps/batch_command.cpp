@@ -44,7 +44,7 @@ pipeline::BatchOptions job_options(const BatchCommand& cmd) {
     throw UsageError("batch: give --threads before '--' (the batch's own arena)");
   }
   o.lk = o.tracker.lk = lk_params(lk);
-  o.tracker.mode = stages::track_mode_from_string(mode);
+  o.tracker.mode = tracking::track_mode_from_string(mode);
   if (o.job == pipeline::BatchJob::Track) as_usage([&] { o.tracker.validate(); });
   return o;
 }

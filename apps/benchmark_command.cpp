@@ -3,7 +3,7 @@
 
 #include "cli_common.hpp"
 #include "pipeline/benchmark.hpp"
-#include "stages/box_tracker.hpp"
+#include "tracking/box_tracker.hpp"
 
 namespace roiflow::cli {
 
@@ -26,7 +26,7 @@ void add_benchmark_command(CLI::App& app, int& /*exit_code*/) {
   sub->add_option("--trackers", run.trackers, "trackers to run, in the order to report")
       ->type_name("LIST")
       ->delimiter(',')
-      ->check([](const std::string& t) { return stages::box_tracker_check(t); })
+      ->check([](const std::string& t) { return tracking::box_tracker_check(t); })
       ->capture_default_str();
   sub->add_option("--sequences", run.sequences, "only these sequences (folders)")->delimiter(',');
   sub->add_option("--max-frames", run.max_frames, "at most N frames of each sequence (0 = all)")

@@ -80,7 +80,7 @@ std::pair<CLI::Option*, CLI::Option*> add_pair_inputs(CLI::App& sub, std::string
   return {d, p};
 }
 
-void add_tracker_options(CLI::App& sub, stages::TrackerParams& tracker, std::string* mode,
+void add_tracker_options(CLI::App& sub, tracking::TrackerParams& tracker, std::string* mode,
                          const std::string& who) {
   sub.add_option("--roi", tracker.roi, who + "side of the local region in pixels")
       ->check(CLI::Range(8, 4096))

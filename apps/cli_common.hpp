@@ -50,8 +50,8 @@ std::pair<CLI::Option*, CLI::Option*> add_pair_inputs(CLI::App& sub, std::string
                                                       std::vector<std::vector<std::string>>& pairs,
                                                       const std::string& dir_help);
 // --roi and --lk-patches (prefixed "roiflow: " in `who`), and --mode when `mode` is given.
-void add_tracker_options(CLI::App& sub, stages::TrackerParams& tracker, std::string* mode = nullptr,
-                         const std::string& who = "");
+void add_tracker_options(CLI::App& sub, tracking::TrackerParams& tracker,
+                         std::string* mode = nullptr, const std::string& who = "");
 // --start, --max-frames, --in-flight, --decode-threads.
 void add_source_options(CLI::App& sub, pipeline::SourceOptions& source, int& in_flight);
 

@@ -33,14 +33,14 @@ void add_dense_command(CLI::App& app, int& exit_code) {
     pipeline::DenseRunOptions o = run;
     o.lk = lk_params(lk);
     o.threads = lk.threads;
-    o.flow_format = stages::flow_file_format_from_string(flow_format);
+    o.flow_format = video::flow_file_format_from_string(flow_format);
     if (o.video.empty() && o.flow_dir.empty()) {
       throw UsageError("dense needs --out VIDEO|DIR or --flow-out DIR");
     }
     if (!o.video.empty()) check_output_path(o.video, "--out");
     if (!summary.empty()) check_output_path(summary, "--summary");
     o.cancel = pipeline::cancel_flag();
-    stages::VideoSource video(input, pipeline::source_params(source));
+    video::VideoSource video(input, pipeline::source_params(source));
     pipeline::SignalScope signals;
     pipeline::DenseSummary s = pipeline::run_dense_video(video, o);
     const pipeline::Ending end = pipeline::ending(s.end, s.frames, s.status);

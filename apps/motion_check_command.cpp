@@ -29,7 +29,7 @@ void add_motion_check_command(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   sub->callback([&exit_code] {
     const std::vector<eval::TrackRecord> log = eval::read_track_csv(cmd.log);
-    stages::VideoSource video(cmd.video);
+    video::VideoSource video(cmd.video);
     const pipeline::MotionCheck c =
         pipeline::check_motion([&] { return video.next(); }, log, cmd.params);
     std::cout << (cmd.format == "json" ? pipeline::to_json(c).dump(2) + "\n"

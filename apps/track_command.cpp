@@ -32,7 +32,7 @@ int run_objects(const TrackCommand& cmd) {
   pipeline::check_track_outputs(o.log, o.video, cmd.summary, o.mot);
   o.threads = cmd.lk.threads, o.in_flight = cmd.run.max_in_flight, o.progress = cmd.run.progress;
   o.cancel = pipeline::cancel_flag();
-  stages::VideoSource source(cmd.input, pipeline::source_params(cmd.source));
+  video::VideoSource source(cmd.input, pipeline::source_params(cmd.source));
   pipeline::SignalScope signals;
   const pipeline::MotRun r = pipeline::track_objects_video(source, o);
   const std::string what = "track " + source.description();
@@ -46,7 +46,7 @@ int run_objects(const TrackCommand& cmd) {
 int run_single(const TrackCommand& cmd) {
   pipeline::TrackRunOptions run = cmd.run;
   run.tracker.lk = lk_params(cmd.lk);
-  run.tracker.mode = stages::track_mode_from_string(cmd.mode);
+  run.tracker.mode = tracking::track_mode_from_string(cmd.mode);
   if (!cmd.inits.empty()) {
     as_usage([&] { run.tracker.init = eval::parse_box(cmd.inits.front()); }, "--init: ");
   }
@@ -62,7 +62,7 @@ int run_single(const TrackCommand& cmd) {
     return run_end(pipeline::compare_ending(r));
   }
   pipeline::check_track_outputs(run.log, run.video, cmd.summary);
-  stages::VideoSource source(cmd.input, pipeline::source_params(cmd.source));
+  video::VideoSource source(cmd.input, pipeline::source_params(cmd.source));
   pipeline::SignalScope signals;
   const pipeline::TrackSummary s = pipeline::run_track_video(source, run);
   const pipeline::Ending end = pipeline::ending(s.end, s.frames, s.status);

@@ -35,7 +35,7 @@ constexpr int kFrames = 120;
 struct Clip {
   int objects = 0;
   cv::Size size;
-  std::vector<roiflow::stages::Frame> frames;
+  std::vector<roiflow::video::Frame> frames;
   std::vector<roiflow::eval::MotBox> truth;
 };
 
@@ -52,7 +52,7 @@ const Clip& clip(int objects, cv::Size size) {
   p.objects = objects;
   const eval::TrafficScene scene(p);
   for (int i = 0; i < kFrames; ++i) {
-    stages::Frame f;
+    video::Frame f;
     f.index = i;
     f.timestamp_s = i / 25.0;
     f.image = scene.render(i);
@@ -74,7 +74,7 @@ void bm_track_objects(benchmark::State& state, int objects, cv::Size size, int t
     pipeline::MotRunOptions o;
     o.threads = threads;
     o.on_frame = [&](const pipeline::MotTrackedFrame& f) {
-      for (const stages::MotObject& t : f.output->objects) {
+      for (const tracking::MotObject& t : f.output->objects) {
         if (t.lost) continue;
         eval::MotBox b;
         b.frame = static_cast<int>(f.output->index) + 1;
@@ -84,7 +84,7 @@ void bm_track_objects(benchmark::State& state, int objects, cv::Size size, int t
       }
     };
     const pipeline::MotRun run = pipeline::track_objects(
-        [&]() -> std::optional<stages::Frame> {
+        [&]() -> std::optional<video::Frame> {
           if (next >= c.frames.size()) return std::nullopt;
           return c.frames[next++];
         },

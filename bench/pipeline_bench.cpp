@@ -62,9 +62,9 @@
 #include "pipeline/frame_graph.hpp"
 #include "pipeline/tbb_executor.hpp"
 #include "report/run_stats.hpp"
-#include "stages/tracker.hpp"
-#include "stages/video_sink.hpp"
-#include "stages/video_source.hpp"
+#include "tracking/tracker.hpp"
+#include "video/video_sink.hpp"
+#include "video/video_source.hpp"
 
 namespace {
 
@@ -79,7 +79,7 @@ std::string synthetic_video() {
     eval::TrackingSceneParams params;
     params.frames = 300;
     const eval::TrackingScene scene(params);
-    stages::VideoSink sink(path.string(), 25.0, scene.size());
+    video::VideoSink sink(path.string(), 25.0, scene.size());
     for (int i = 0; i < scene.frames(); ++i)
       sink.write(scene.render(i));
     sink.close();
@@ -93,7 +93,7 @@ std::string synthetic_hd_video() {
   const fs::path path = fs::temp_directory_path() / "roiflow_bench_synthetic1920x1080_h264.mp4";
   if (!fs::exists(path)) {
     const fs::path partial = path.string() + ".partial.mp4";
-    stages::VideoSource scene("synthetic:300:1920x1080");
+    video::VideoSource scene("synthetic:300:1920x1080");
     cv::VideoWriter writer(partial.string(), cv::CAP_FFMPEG,
                            cv::VideoWriter::fourcc('a', 'v', 'c', '1'), 25, scene.size());
     if (!writer.isOpened()) return {};
@@ -111,15 +111,15 @@ double ms_total(const nlohmann::ordered_json& stats, const char* stage) {
 }
 
 // How the CLI reads a video for tracking and dense mode: colour only when asked for.
-stages::VideoSourceParams as_the_cli() {
-  stages::VideoSourceParams params;
+video::VideoSourceParams as_the_cli() {
+  video::VideoSourceParams params;
   params.defer_colour = true;
   return params;
 }
 
 // One decode-only pass over the file read with `params`: its frame count.
-long long decode_pass(const std::string& path, const stages::VideoSourceParams& params) {
-  stages::VideoSource source(path, params);
+long long decode_pass(const std::string& path, const video::VideoSourceParams& params) {
+  video::VideoSource source(path, params);
   long long frames = 0;
   while (auto f = source.next()) {
     benchmark::DoNotOptimize(f->image.data);
@@ -153,13 +153,13 @@ long long decode_all_opencv(const std::string& path) {
 }
 
 // One tracking run of the file (default params but `mode`), no sinks; `stats` may be null.
-pipeline::RunReport track_all(const std::string& path, stages::TrackMode mode, int threads,
+pipeline::RunReport track_all(const std::string& path, tracking::TrackMode mode, int threads,
                               report::RunStats* stats, long long* activations = nullptr) {
-  stages::VideoSource source(path, as_the_cli());
+  video::VideoSource source(path, as_the_cli());
   pipeline::TbbExecutor tiles;
-  stages::TrackerParams params;
+  tracking::TrackerParams params;
   params.mode = mode;
-  stages::Tracker tracker(params, &tiles);
+  tracking::Tracker tracker(params, &tiles);
   pipeline::GraphOptions options;
   options.threads = threads;
   options.stats = stats;
@@ -178,7 +178,7 @@ void bm_decode(benchmark::State& state, const std::string& path) {
       benchmark::Counter(static_cast<double>(frames), benchmark::Counter::kIsRate);
 }
 
-void bm_track(benchmark::State& state, const std::string& path, stages::TrackMode mode,
+void bm_track(benchmark::State& state, const std::string& path, tracking::TrackMode mode,
               int threads) {
   long long frames = 0;
   double tracker_ms = 0;
@@ -214,7 +214,7 @@ double decode_fps(const std::string& path) {
 }
 
 double tracking_fps(const std::string& path, int threads) {
-  const pipeline::RunReport report = track_all(path, stages::TrackMode::Local, threads, nullptr);
+  const pipeline::RunReport report = track_all(path, tracking::TrackMode::Local, threads, nullptr);
   return report.frames / report.wall_s;
 }
 
@@ -268,11 +268,11 @@ void bm_track_vs_decode(benchmark::State& state, const std::string& path, int th
 void bm_graph_only(benchmark::State& state, const std::string& path) {
   long long frames = 0;
   for (auto _ : state) {
-    stages::VideoSource source(path, as_the_cli());
+    video::VideoSource source(path, as_the_cli());
     pipeline::TrackStep step;
     step.wants_pyramid = [] { return false; };
-    step.process = [](const stages::TrackerInput& in) {
-      stages::TrackerOutput out;
+    step.process = [](const tracking::TrackerInput& in) {
+      tracking::TrackerOutput out;
       out.index = in.index;
       return out;
     };
@@ -290,19 +290,19 @@ void bm_graph_only(benchmark::State& state, const std::string& path) {
 // local treatment kept.
 void bm_tracker_only(benchmark::State& state, const std::string& path) {
   // Decoded once for all repetitions.
-  static std::map<std::string, std::vector<stages::Frame>> decoded;
-  std::vector<stages::Frame>& frames = decoded[path];
+  static std::map<std::string, std::vector<video::Frame>> decoded;
+  std::vector<video::Frame>& frames = decoded[path];
   if (frames.empty()) {
-    stages::VideoSource source(path, as_the_cli());
+    video::VideoSource source(path, as_the_cli());
     while (auto f = source.next())
       frames.push_back(std::move(*f));
   }
   double total_ms = 0, local_ms = 0;
   long long runs = 0, local_frames = 0;
   for (auto _ : state) {
-    stages::Tracker tracker(stages::TrackerParams{});
-    for (const stages::Frame& f : frames) {
-      const stages::TrackerOutput out =
+    tracking::Tracker tracker(tracking::TrackerParams{});
+    for (const video::Frame& f : frames) {
+      const tracking::TrackerOutput out =
           tracker.process({f.index, f.image, f.gray, nullptr, f.deferred_image});
       total_ms += out.ms;
       if (out.mode == eval::TrackRecord::Mode::Local && !out.lost) {
@@ -319,7 +319,7 @@ void bm_tracker_only(benchmark::State& state, const std::string& path) {
 void bm_dense(benchmark::State& state, const std::string& path, int threads) {
   long long pairs = 0;
   for (auto _ : state) {
-    stages::VideoSource source(path, as_the_cli());
+    video::VideoSource source(path, as_the_cli());
     pipeline::GraphOptions options;
     options.threads = threads;
     const pipeline::RunReport report =
@@ -345,8 +345,8 @@ void register_video(const std::string& name, const std::string& path) {
       ->UseRealTime()
       ->Iterations(1);
   for (int threads : kThreadCounts) {
-    for (stages::TrackMode mode : {stages::TrackMode::Local, stages::TrackMode::Global}) {
-      const std::string bm = "BM_Track/" + name + "/" + stages::to_string(mode) +
+    for (tracking::TrackMode mode : {tracking::TrackMode::Local, tracking::TrackMode::Global}) {
+      const std::string bm = "BM_Track/" + name + "/" + tracking::to_string(mode) +
                              "/threads:" + std::to_string(threads);
       benchmark::RegisterBenchmark(bm.c_str(), bm_track, path, mode, threads)
           ->Unit(benchmark::kMillisecond)

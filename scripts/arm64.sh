@@ -3,7 +3,7 @@
 # its tests under qemu-user: the paper's platform (a Raspberry Pi 4's Cortex-A72) checked from CI.
 #
 #   scripts/arm64.sh                 # the flow tests (the kernels): ~3 min on two cores
-#   scripts/arm64.sh flow eval       # test labels to run (flow core eval pipeline stages report)
+#   scripts/arm64.sh flow eval       # test labels to run (flow core eval report video tracking pipeline)
 #
 # Host packages (amd64, co-install with everything): crossbuild-essential-arm64 qemu-user
 # mmdebstrap. The arm64 libraries live in a separate sysroot (build/arm64-sysroot, or
@@ -62,8 +62,8 @@ fi
 targets=()
 for label in "${labels[@]}"; do
   case "$label" in
-    flow | core | eval | report | stages | pipeline) targets+=("roiflow_${label}_tests") ;;
-    *) echo "arm64: unknown test label '$label' (flow core eval report stages pipeline)" >&2; exit 2 ;;
+    flow | core | eval | report | video | tracking | pipeline) targets+=("roiflow_${label}_tests") ;;
+    *) echo "arm64: unknown test label '$label' (flow core eval report video tracking pipeline)" >&2; exit 2 ;;
   esac
 done
 

@@ -5,7 +5,7 @@
 //
 // The planes are copied: the tracker and the flow keep the previous frame after the buffer has
 // gone back to its pool. I420 and NV12 frames become gray and BGR exactly as `roiflow track`'s
-// decoder makes them (stages/yuv_frame.hpp: video-range luma expanded to 0..255, swscale for
+// decoder makes them (video/yuv_frame.hpp: video-range luma expanded to 0..255, swscale for
 // the picture), so the element tracks as the CLI does on the same decoded video; the BGR
 // picture (which the tracker asks for to learn appearance and background) is converted only
 // when asked. GRAY8 frames are the gray frame and their own picture.
@@ -17,14 +17,14 @@
 #include <memory>
 #include <opencv2/core.hpp>
 
-#include "stages/deferred_image.hpp"
-#include "stages/yuv_frame.hpp"
+#include "video/deferred_image.hpp"
+#include "video/yuv_frame.hpp"
 
 namespace roiflow::gst {
 
 struct OwnedFrame {
-  cv::Mat gray;                                          // CV_8UC1, owned
-  std::shared_ptr<const stages::DeferredImage> picture;  // BGR on demand; null = the gray frame
+  cv::Mat gray;                                         // CV_8UC1, owned
+  std::shared_ptr<const video::DeferredImage> picture;  // BGR on demand; null = the gray frame
 };
 
 // Plane `plane` of `frame` (rows x row_bytes), copied.
@@ -43,16 +43,16 @@ inline OwnedFrame copy_frame(const GstVideoFrame* frame) {
     out.gray = copy_plane(frame, 0, h, w);
     return out;
   }
-  stages::YuvPlanes planes;
+  video::YuvPlanes planes;
   const int cw = (w + 1) / 2, ch = (h + 1) / 2;
   planes.nv12 = format == GST_VIDEO_FORMAT_NV12;
   planes.full_range = frame->info.colorimetry.range == GST_VIDEO_COLOR_RANGE_0_255;
   planes.y = copy_plane(frame, 0, h, w);
   planes.u = copy_plane(frame, 1, ch, planes.nv12 ? 2 * cw : cw);
   if (!planes.nv12) planes.v = copy_plane(frame, 2, ch, cw);
-  out.gray = stages::yuv_gray(planes);
+  out.gray = video::yuv_gray(planes);
   out.picture =
-      std::make_shared<stages::DeferredImage>([planes] { return stages::yuv_to_bgr(planes); });
+      std::make_shared<video::DeferredImage>([planes] { return video::yuv_to_bgr(planes); });
   return out;
 }
 

@@ -1,7 +1,7 @@
 // The GStreamer elements of libgstroiflow.so (docs/DROPIN.md):
 //
 //   roiflowtrack  a GstVideoFilter (GRAY8, I420, NV12; the luma plane is the gray frame) that
-//                 tracks objects with stages::ObjectTracker and attaches one
+//                 tracks objects with tracking::ObjectTracker and attaches one
 //                 GstVideoRegionOfInterestMeta per object (roi_type "roiflow", id = the object's
 //                 id, a "roiflow/track" param: id, x, y, w, h, vx, vy, mode, lost, frame);
 //                 optional track log (the CSV/JSON `roiflow track --log` writes) and drawing.

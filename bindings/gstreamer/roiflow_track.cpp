@@ -1,4 +1,4 @@
-// roiflowtrack: stages::ObjectTracker as a GstVideoFilter (gst_roiflow.hpp, docs/DROPIN.md).
+// roiflowtrack: tracking::ObjectTracker as a GstVideoFilter (gst_roiflow.hpp, docs/DROPIN.md).
 //
 // Conventions: the caps are the same on both pads (GRAY8, I420 or NV12, any size and rate); the
 // buffer passes through in place with one GstVideoRegionOfInterestMeta per object (draw=true
@@ -28,8 +28,8 @@
 #include "frame_copy.hpp"
 #include "gst_roiflow.hpp"
 #include "pipeline/tbb_executor.hpp"
-#include "stages/object_tracker.hpp"
-#include "stages/track_log_sink.hpp"
+#include "tracking/object_tracker.hpp"
+#include "video/track_log_sink.hpp"
 
 GST_DEBUG_CATEGORY_STATIC(roiflow_track_debug);
 #define GST_CAT_DEFAULT roiflow_track_debug
@@ -81,9 +81,9 @@ struct Run {
   explicit Run(int threads) : arena(threads) {}
   pipeline::TbbExecutor executor;
   tbb::task_arena arena;
-  stages::ObjectTrackerParams params;
-  std::unique_ptr<stages::ObjectTracker> tracker;
-  std::optional<stages::TrackLogWriter> log;
+  tracking::ObjectTrackerParams params;
+  std::unique_ptr<tracking::ObjectTracker> tracker;
+  std::optional<video::TrackLogWriter> log;
   cv::Size size;
   long long index = 0;
   bool draw = false;
@@ -235,7 +235,7 @@ gboolean start(GstBaseTransform* trans) {
   try {
     auto run = std::make_unique<Run>(s.threads == 0 ? hardware_threads() : s.threads);
     run->params.tracker.mode =
-        s.mode == kModeGlobal ? stages::TrackMode::Global : stages::TrackMode::Local;
+        s.mode == kModeGlobal ? tracking::TrackMode::Global : tracking::TrackMode::Local;
     run->params.tracker.roi = s.roi;
     run->params.tracker.lk = flow::LkParams::preset(s.preset);
     run->params.init = parse_boxes(s.init);
@@ -298,11 +298,11 @@ gboolean set_info(GstVideoFilter* filter, GstCaps*, GstVideoInfo* in_info, GstCa
   return TRUE;
 }
 
-void draw_objects(GstVideoFrame* frame, const std::vector<stages::TrackedObject>& objects) {
+void draw_objects(GstVideoFrame* frame, const std::vector<tracking::TrackedObject>& objects) {
   cv::Mat luma(GST_VIDEO_FRAME_HEIGHT(frame), GST_VIDEO_FRAME_WIDTH(frame), CV_8UC1,
                GST_VIDEO_FRAME_PLANE_DATA(frame, 0),
                static_cast<std::size_t>(GST_VIDEO_FRAME_PLANE_STRIDE(frame, 0)));
-  for (const stages::TrackedObject& o : objects) {
+  for (const tracking::TrackedObject& o : objects) {
     const cv::Rect box(cvRound(o.box.x), cvRound(o.box.y), cvRound(o.box.width),
                        cvRound(o.box.height));
     // found: white, lost (the prediction): black; global treatment: thinner
@@ -313,7 +313,7 @@ void draw_objects(GstVideoFrame* frame, const std::vector<stages::TrackedObject>
   }
 }
 
-void attach_meta(GstBuffer* buffer, const stages::TrackedObject& o, long long index,
+void attach_meta(GstBuffer* buffer, const tracking::TrackedObject& o, long long index,
                  cv::Size size) {
   const auto clip = [](double v, int limit) {
     return static_cast<guint>(std::clamp(v, 0.0, static_cast<double>(limit)));
@@ -343,16 +343,16 @@ GstFlowReturn transform_frame_ip(GstVideoFilter* filter, GstVideoFrame* frame) {
   if (run == nullptr) return GST_FLOW_FLUSHING;
   try {
     if (!run->tracker)
-      run->tracker = std::make_unique<stages::ObjectTracker>(run->params, &run->executor);
+      run->tracker = std::make_unique<tracking::ObjectTracker>(run->params, &run->executor);
     const gst::OwnedFrame owned = gst::copy_frame(frame);
-    stages::TrackerInput in;
+    tracking::TrackerInput in;
     in.index = run->index;
     in.gray = owned.gray;
     in.deferred_image = owned.picture;
-    std::vector<stages::TrackedObject> objects;
+    std::vector<tracking::TrackedObject> objects;
     run->arena.execute([&] { objects = run->tracker->update(in); });
     if (run->log) run->log->write(run->tracker->primary().record());
-    for (const stages::TrackedObject& o : objects)
+    for (const tracking::TrackedObject& o : objects)
       attach_meta(frame->buffer, o, run->index, owned.gray.size());
     if (run->draw) draw_objects(frame, objects);
     ++run->index;

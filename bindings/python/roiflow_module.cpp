@@ -35,8 +35,8 @@
 #include "flow/dense_lk.hpp"
 #include "flow/metrics.hpp"
 #include "pipeline/tbb_executor.hpp"
-#include "stages/object_tracker.hpp"
-#include "stages/video_source.hpp"
+#include "tracking/object_tracker.hpp"
+#include "video/video_source.hpp"
 
 namespace py = pybind11;
 using namespace roiflow;
@@ -254,10 +254,10 @@ py::array dense_flow(const py::array& a, const py::array& b, const std::string& 
 
 // ------------------------------------------------------------------------------------ tracker
 
-stages::TrackerParams tracker_params(const std::string& mode, int roi, const std::string& preset,
-                                     const py::kwargs& kwargs, const char* function) {
-  stages::TrackerParams p;
-  p.mode = stages::track_mode_from_string(mode);
+tracking::TrackerParams tracker_params(const std::string& mode, int roi, const std::string& preset,
+                                       const py::kwargs& kwargs, const char* function) {
+  tracking::TrackerParams p;
+  p.mode = tracking::track_mode_from_string(mode);
   p.roi = roi;
   p.lk = lk_params(preset, kwargs, function);
   return p;
@@ -300,23 +300,23 @@ class PyTracker {
   PyTracker(const py::object& init, const std::string& mode, int roi, int max_lost,
             const std::string& preset, int threads, const py::kwargs& kwargs)
       : arena_(check_threads(threads)) {
-    stages::ObjectTrackerParams params;
+    tracking::ObjectTrackerParams params;
     params.tracker = tracker_params(mode, roi, preset, kwargs, "Tracker");
     params.init = boxes_from(init);
     params.max_lost = max_lost;
-    tracker_ = std::make_unique<stages::ObjectTracker>(params, &executor_);
+    tracker_ = std::make_unique<tracking::ObjectTracker>(params, &executor_);
   }
   ~PyTracker() {
     arena_.execute([&] { tracker_->finish_background_work(); });
   }
 
-  std::vector<stages::TrackedObject> update(const py::array& frame) {
+  std::vector<tracking::TrackedObject> update(const py::array& frame) {
     py::array keep;
     const cv::Mat view = as_mat(frame, "Tracker.update: frame", {CV_8U}, {1, 3}, keep);
     eval::check_frame_size(view.size(), "Tracker.update: frame");
-    std::vector<stages::TrackedObject> objects;
+    std::vector<tracking::TrackedObject> objects;
     py::gil_scoped_release release;
-    stages::TrackerInput in;
+    tracking::TrackerInput in;
     in.index = index_;
     if (view.channels() == 3) {
       in.image = view.clone();
@@ -335,7 +335,7 @@ class PyTracker {
  private:
   pipeline::TbbExecutor executor_;
   tbb::task_arena arena_;
-  std::unique_ptr<stages::ObjectTracker> tracker_;
+  std::unique_ptr<tracking::ObjectTracker> tracker_;
   long long index_ = 0;
 };
 
@@ -346,28 +346,28 @@ class TrackIterator {
                 int max_lost, long long start, long long max_frames, const std::string& preset,
                 int threads, const py::kwargs& kwargs)
       : arena_(check_threads(threads)) {
-    stages::ObjectTrackerParams params;
+    tracking::ObjectTrackerParams params;
     params.tracker = tracker_params(mode, roi, preset, kwargs, "track");
     params.init = boxes_from(init);
     params.max_lost = max_lost;
     params.validate();
-    stages::VideoSourceParams source_params;
+    video::VideoSourceParams source_params;
     source_params.start = start;
     source_params.max_frames = max_frames;
     source_params.defer_colour = true;
     {
       py::gil_scoped_release release;
-      source_ = std::make_unique<stages::VideoSource>(input, source_params);
+      source_ = std::make_unique<video::VideoSource>(input, source_params);
     }
-    tracker_ = std::make_unique<stages::ObjectTracker>(params, &executor_);
+    tracker_ = std::make_unique<tracking::ObjectTracker>(params, &executor_);
   }
   ~TrackIterator() {
     arena_.execute([&] { tracker_->finish_background_work(); });
   }
 
   py::tuple next() {
-    std::optional<stages::Frame> frame;
-    std::vector<stages::TrackedObject> objects;
+    std::optional<video::Frame> frame;
+    std::vector<tracking::TrackedObject> objects;
     {
       py::gil_scoped_release release;
       frame = source_->next();
@@ -379,7 +379,7 @@ class TrackIterator {
       }
     }
     if (!frame) {
-      if (source_->status().state == stages::SourceStatus::State::kStopped) {
+      if (source_->status().state == video::SourceStatus::State::kStopped) {
         throw Error("input " + source_->status().message);
       }
       throw py::stop_iteration();
@@ -393,8 +393,8 @@ class TrackIterator {
  private:
   pipeline::TbbExecutor executor_;
   tbb::task_arena arena_;
-  std::unique_ptr<stages::VideoSource> source_;
-  std::unique_ptr<stages::ObjectTracker> tracker_;
+  std::unique_ptr<video::VideoSource> source_;
+  std::unique_ptr<tracking::ObjectTracker> tracker_;
 };
 
 const char* mode_name(eval::TrackRecord::Mode m) {
@@ -490,20 +490,21 @@ PYBIND11_MODULE(roiflow, m) {
       "AAE (deg), EPE (px), R1, R3, Fl (%) and pixels counted, as roiflow eval computes them.");
   m.def("presets", &flow::LkParams::preset_names, "The LK presets' names.");
 
-  py::class_<stages::TrackedObject>(m, "TrackedObject")
-      .def_readonly("id", &stages::TrackedObject::id)
+  py::class_<tracking::TrackedObject>(m, "TrackedObject")
+      .def_readonly("id", &tracking::TrackedObject::id)
       .def_property_readonly("box",
-                             [](const stages::TrackedObject& o) {
+                             [](const tracking::TrackedObject& o) {
                                return py::make_tuple(o.box.x, o.box.y, o.box.width, o.box.height);
                              })
-      .def_property_readonly(
-          "velocity",
-          [](const stages::TrackedObject& o) { return py::make_tuple(o.velocity.x, o.velocity.y); })
+      .def_property_readonly("velocity",
+                             [](const tracking::TrackedObject& o) {
+                               return py::make_tuple(o.velocity.x, o.velocity.y);
+                             })
       .def_property_readonly("mode",
-                             [](const stages::TrackedObject& o) { return mode_name(o.mode); })
-      .def_readonly("lost", &stages::TrackedObject::lost)
-      .def_readonly("lost_frames", &stages::TrackedObject::lost_frames)
-      .def("__repr__", [](const stages::TrackedObject& o) {
+                             [](const tracking::TrackedObject& o) { return mode_name(o.mode); })
+      .def_readonly("lost", &tracking::TrackedObject::lost)
+      .def_readonly("lost_frames", &tracking::TrackedObject::lost_frames)
+      .def("__repr__", [](const tracking::TrackedObject& o) {
         return "TrackedObject(id=" + std::to_string(o.id) + ", box=(" + std::to_string(o.box.x) +
                ", " + std::to_string(o.box.y) + ", " + std::to_string(o.box.width) + ", " +
                std::to_string(o.box.height) + "), mode=" + mode_name(o.mode) +

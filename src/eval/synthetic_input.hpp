@@ -7,7 +7,7 @@
 //
 // Grammar: synthetic:FRAMES[:WxH][:OBJECTS]. FRAMES in 1..10^9; WxH each side 64..8192
 // (default 640x480) and within eval::check_frame_size; OBJECTS in 1..256. Without OBJECTS the
-// input is eval::TrackingScene's single vehicle (stages::VideoSource plays it forwards and
+// input is eval::TrackingScene's single vehicle (video::VideoSource plays it forwards and
 // backwards); with OBJECTS it is eval::TrafficScene with that many vehicles, FRAMES long, whose
 // ground_truth() holds every box. "synthetic:300:16" is 640x480 with 16 vehicles.
 #pragma once

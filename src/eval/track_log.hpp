@@ -4,7 +4,7 @@
 // `global`, lost `0` or `1`. The reader also takes the logs written before the id column
 // (`frame,x,y,w,h,vx,vy,mode,lost,ms`: every record gets id 1). JSON: an array of objects with the
 // same keys and rounding, one per line. The writer that keeps a file valid while a run goes is
-// stages::TrackLogWriter.
+// video::TrackLogWriter.
 //
 //   roiflow::eval::TrackRecord r;
 //   r.box = {70, 51, 107, 87};  // frame 1, id 1

@@ -207,7 +207,7 @@ int flow_pyramid_levels(cv::Size size, const LkParams& params, const FlowOptions
 // The level-0 pixels of frame t whose values dense_flow reads for `options` (the rectangles it
 // computes at every level, scaled to level 0; the warps of frame t+1 reach further by the
 // flow itself). A caller that builds pyramids of only part of a frame builds them over this
-// (see stages::LocalTracker). `size`: the frame's.
+// (see tracking::LocalTracker). `size`: the frame's.
 cv::Rect flow_footprint(cv::Size size, const LkParams& params, const FlowOptions& options);
 
 const char* to_string(Derivative d);

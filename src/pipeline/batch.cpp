@@ -25,9 +25,9 @@
 #include "flow/color_code.hpp"
 #include "flow/pyramid.hpp"
 #include "pipeline/tbb_executor.hpp"
-#include "stages/track_log_sink.hpp"
-#include "stages/video_sink.hpp"
-#include "stages/video_source.hpp"
+#include "video/track_log_sink.hpp"
+#include "video/video_sink.hpp"
+#include "video/video_source.hpp"
 
 namespace roiflow::pipeline {
 namespace {
@@ -118,18 +118,18 @@ bool cancelled(const BatchOptions& options) {
 // Runs one video into `dir`; returns the frames done. Throws roiflow::Error on failure.
 long long run_track(const std::string& video, const fs::path& dir, const BatchOptions& options,
                     const TbbExecutor& executor, bool& stopped) {
-  stages::VideoSourceParams sp;
+  video::VideoSourceParams sp;
   sp.max_frames = options.max_frames;
   sp.defer_colour = true;
-  stages::VideoSource source(video, sp);
-  stages::Tracker tracker(options.tracker, &executor);
-  stages::TrackLogWriter log((dir / "track.csv").string());
+  video::VideoSource source(video, sp);
+  tracking::Tracker tracker(options.tracker, &executor);
+  video::TrackLogWriter log((dir / "track.csv").string());
   long long frames = 0;
   try {
     while (!cancelled(options)) {
-      std::optional<stages::Frame> f = source.next();
+      std::optional<video::Frame> f = source.next();
       if (!f) break;
-      const stages::TrackerOutput out =
+      const tracking::TrackerOutput out =
           tracker.process({f->index, f->image, f->gray, nullptr, f->deferred_image});
       log.write(out.record());
       ++frames;
@@ -141,7 +141,7 @@ long long run_track(const std::string& video, const fs::path& dir, const BatchOp
   tracker.finish_background_work();
   log.close();
   stopped = cancelled(options);
-  if (source.status().state == stages::SourceStatus::State::kStopped) {
+  if (source.status().state == video::SourceStatus::State::kStopped) {
     throw Error("input " + source.status().message);
   }
   return frames;
@@ -149,10 +149,10 @@ long long run_track(const std::string& video, const fs::path& dir, const BatchOp
 
 long long run_dense_job(const std::string& video, const fs::path& dir, const BatchOptions& options,
                         const TbbExecutor& executor, bool& stopped) {
-  stages::VideoSourceParams sp;
+  video::VideoSourceParams sp;
   sp.max_frames = options.max_frames;
-  stages::VideoSource source(video, sp);
-  stages::VideoSink sink((dir / "flow.avi").string(), source.fps(), source.size());
+  video::VideoSource source(video, sp);
+  video::VideoSink sink((dir / "flow.avi").string(), source.fps(), source.size());
   flow::DenseLK lk(options.lk, &executor);
   flow::FlowResult result;
   flow::Pyramid previous, current;
@@ -160,7 +160,7 @@ long long run_dense_job(const std::string& video, const fs::path& dir, const Bat
   bool have_previous = false;
   long long frames = 0;
   while (!cancelled(options)) {
-    std::optional<stages::Frame> f = source.next();
+    std::optional<video::Frame> f = source.next();
     if (!f) break;
     flow::build_pyramid(f->gray, levels, options.lk.sigma, current);
     if (have_previous) {
@@ -173,7 +173,7 @@ long long run_dense_job(const std::string& video, const fs::path& dir, const Bat
   }
   sink.close();
   stopped = cancelled(options);
-  if (source.status().state == stages::SourceStatus::State::kStopped) {
+  if (source.status().state == video::SourceStatus::State::kStopped) {
     throw Error("input " + source.status().message);
   }
   return frames;

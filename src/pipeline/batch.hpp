@@ -38,7 +38,7 @@
 
 #include "flow/dense_lk.hpp"
 #include "pipeline/signals.hpp"
-#include "stages/tracker.hpp"
+#include "tracking/tracker.hpp"
 
 namespace roiflow::pipeline {
 
@@ -57,7 +57,7 @@ struct BatchRow {
 struct BatchOptions {
   BatchJob job = BatchJob::Track;
   std::string out_dir;
-  stages::TrackerParams tracker;                // track: every video's (init is refused)
+  tracking::TrackerParams tracker;              // track: every video's (init is refused)
   flow::LkParams lk = flow::LkParams::paper();  // dense
   float max_motion = -1.f;                      // dense: colour saturation; <= 0 per frame
   long long max_frames = 0;                     // per video; 0 = all

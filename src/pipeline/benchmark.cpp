@@ -19,8 +19,8 @@
 #include "core/text.hpp"
 #include "pipeline/tbb_executor.hpp"
 #include "report/otb_plot.hpp"
-#include "stages/box_tracker.hpp"
-#include "stages/video_source.hpp"
+#include "tracking/box_tracker.hpp"
+#include "video/video_source.hpp"
 
 namespace roiflow::pipeline {
 namespace fs = std::filesystem;
@@ -54,21 +54,21 @@ void check_trackers(const std::vector<std::string>& trackers) {
   if (trackers.empty()) throw Error("no tracker to benchmark");
   std::set<std::string> seen;
   for (const std::string& t : trackers) {
-    stages::make_box_tracker(t);  // throws for an unknown name, listing the known ones
+    tracking::make_box_tracker(t);  // throws for an unknown name, listing the known ones
     if (!seen.insert(t).second) throw Error("tracker '" + t + "' is listed twice");
   }
 }
 
 struct Job {
   eval::OtbSequence sequence;
-  std::optional<stages::VideoSource> source;
+  std::optional<video::VideoSource> source;
   std::vector<eval::TrackerRun> runs;
 };
 
 // Opens the sequence's frames and checks them against its ground truth.
 void open_job(Job& job, long long max_frames, cv::Point2f shift) {
   const eval::OtbSequence& s = job.sequence;
-  stages::VideoSourceParams params;
+  video::VideoSourceParams params;
   params.max_frames = max_frames;
   job.source.emplace(s.dir, params);
   const long long images = job.source->frame_count_hint();
@@ -95,19 +95,19 @@ void open_job(Job& job, long long max_frames, cv::Point2f shift) {
 }
 
 void run_job(Job& job, const BenchmarkOptions& options) {
-  std::vector<std::unique_ptr<stages::BoxTracker>> trackers;
+  std::vector<std::unique_ptr<tracking::BoxTracker>> trackers;
   bool any_opencv = false;
   for (const std::string& name : options.trackers) {
-    trackers.push_back(stages::make_box_tracker(name, options.roiflow));
+    trackers.push_back(tracking::make_box_tracker(name, options.roiflow));
     any_opencv = any_opencv || name != "roiflow";
   }
   job.runs.assign(trackers.size(), {});
   long long frames = 0;
-  while (std::optional<stages::Frame> frame = job.source->next()) {
-    const cv::Mat bgr = any_opencv ? stages::bgr_picture(*frame) : cv::Mat();
+  while (std::optional<video::Frame> frame = job.source->next()) {
+    const cv::Mat bgr = any_opencv ? tracking::bgr_picture(*frame) : cv::Mat();
     for (std::size_t t = 0; t < trackers.size(); ++t) {
       const double start = thread_cpu_s();
-      const stages::BoxUpdate u =
+      const tracking::BoxUpdate u =
           frames == 0
               ? trackers[t]->start(*frame, bgr, job.sequence.truth.front() + options.init_shift)
               : trackers[t]->next(*frame, bgr);
@@ -119,8 +119,8 @@ void run_job(Job& job, const BenchmarkOptions& options) {
     }
     ++frames;
   }
-  const stages::SourceStatus& status = job.source->status();
-  if (status.state == stages::SourceStatus::State::kStopped) {
+  const video::SourceStatus& status = job.source->status();
+  if (status.state == video::SourceStatus::State::kStopped) {
     throw Error(job.sequence.name + ": " + status.message);
   }
   job.source.reset();  // its buffers go now, not with the whole run

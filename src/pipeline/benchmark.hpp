@@ -16,17 +16,17 @@
 #include <vector>
 
 #include "eval/otb_benchmark.hpp"
-#include "stages/tracker.hpp"
+#include "tracking/tracker.hpp"
 
 namespace roiflow::pipeline {
 
 struct BenchmarkOptions {
   std::string dir;                     // OTB-layout folder, or one sequence's folder
-  std::vector<std::string> trackers;   // stages::box_tracker_names(), in the order to report
+  std::vector<std::string> trackers;   // tracking::box_tracker_names(), in the order to report
   std::vector<std::string> sequences;  // only these (folder names); empty = all
   int threads = 1;                     // sequences run at once, 1..256
   long long max_frames = 0;            // at most this many frames of each sequence; 0 = all
-  stages::TrackerParams roiflow;       // roiflow's settings (init is set per sequence)
+  tracking::TrackerParams roiflow;     // roiflow's settings (init is set per sequence)
   // Every tracker starts from the first ground-truth box moved by this many pixels (scoring
   // still uses the true boxes): OTB's spatial-robustness check, |each| <= 1000.
   cv::Point2f init_shift;

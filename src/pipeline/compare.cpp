@@ -36,14 +36,14 @@ CompareRun compare_run(const CompareOptions& o, const char* mode, int patch,
     std::cerr << "compare: " << mode << " mode, patch " << patch << " ..." << std::endl;
   }
   TrackRunOptions run = o.run;
-  run.tracker.mode = stages::track_mode_from_string(mode);
+  run.tracker.mode = tracking::track_mode_from_string(mode);
   run.tracker.lk.patch = patch;
   run.tracker.validate();
   run.log = stem.empty() ? "" : (fs::path(o.out_dir) / (stem + ".csv")).string();
   run.video.clear();
   run.progress = false;
   run.keep_records = true;
-  stages::VideoSource source(o.input, source_params(o.source));
+  video::VideoSource source(o.input, source_params(o.source));
   CompareRun r;
   r.mode = mode;
   r.patch = patch;
@@ -160,8 +160,8 @@ CompareResult run_compare(const CompareOptions& o) {
                      ") would show each mode different frames");
   }
   // Opened here only to check the input and the init box before any run starts.
-  check_init_inside(o.run.tracker.init,
-                    stages::VideoSource(o.input, source_params(o.source)).size(), 0.f);
+  check_init_inside(o.run.tracker.init, video::VideoSource(o.input, source_params(o.source)).size(),
+                    0.f);
   std::error_code ec;
   if (fs::exists(o.out_dir, ec) && !fs::is_directory(o.out_dir, ec)) {
     throw Error("--compare-out: '" + o.out_dir + "' exists and is not a directory");

@@ -15,9 +15,9 @@ namespace {
 namespace fs = std::filesystem;
 
 FrameSource scene_source(const eval::TrackingScene& scene) {
-  return [&scene, next = 0]() mutable -> std::optional<stages::Frame> {
+  return [&scene, next = 0]() mutable -> std::optional<video::Frame> {
     if (next >= scene.frames()) return std::nullopt;
-    stages::Frame f;
+    video::Frame f;
     f.index = next;
     f.timestamp_s = next / 25.0;
     f.image = scene.render(next);
@@ -58,7 +58,7 @@ DemoResult run_demo(const DemoOptions& options) {
   run.cancel = options.cancel;
   r.local = run_track_stream(scene_source(scene), info, run);
   if (r.local.end == RunEnd::Cancelled) return r;
-  run.tracker.mode = stages::TrackMode::Global;
+  run.tracker.mode = tracking::TrackMode::Global;
   run.log.clear();
   run.video.clear();
   run.progress = false;

@@ -17,17 +17,16 @@ DenseOutputs::DenseOutputs(const DenseOutputOptions& options, double fps, cv::Si
                 std::to_string(options.max_motion));
   }
   max_motion_ = options.max_motion > 0 ? static_cast<float>(options.max_motion) : -1.f;
-  if (!options.video.empty())
-    video_ = std::make_unique<stages::VideoSink>(options.video, fps, size);
+  if (!options.video.empty()) video_ = std::make_unique<video::VideoSink>(options.video, fps, size);
   if (!options.flow_dir.empty()) {
-    flow_ = std::make_unique<stages::FlowFileSink>(options.flow_dir, options.flow_format);
+    flow_ = std::make_unique<video::FlowFileSink>(options.flow_dir, options.flow_format);
   }
 }
 
 std::vector<FlowSink> DenseOutputs::sinks() {
   std::vector<FlowSink> out;
   if (video_) {
-    stages::VideoSink* video = video_.get();
+    video::VideoSink* video = video_.get();
     const float max_motion = max_motion_;
     out.push_back({"video", [video](const FlowPair& p) { video->write_encoded(p.prepared); },
                    [video, max_motion](const FlowPair& p) {
@@ -35,7 +34,7 @@ std::vector<FlowSink> DenseOutputs::sinks() {
                    }});
   }
   if (flow_) {
-    stages::FlowFileSink* files = flow_.get();
+    video::FlowFileSink* files = flow_.get();
     out.push_back({"flow_files", [files](const FlowPair& p) { files->write_encoded(p.prepared); },
                    [files](const FlowPair& p) { return files->encode(p.flow->flow); }});
   }

@@ -7,8 +7,8 @@
 //   pipeline::DenseOutputOptions out;
 //   out.video = "run/colour/";                        // PNG folder (or "run/flow.mp4")
 //   out.flow_dir = "run/flow";                        // run/flow/000001.png, ...
-//   out.flow_format = stages::FlowFileFormat::Kitti;
-//   stages::VideoSource source("synthetic:10");
+//   out.flow_format = video::FlowFileFormat::Kitti;
+//   video::VideoSource source("synthetic:10");
 //   pipeline::DenseOutputs outputs(out, source.fps(), source.size());
 //   pipeline::run_dense([&] { return source.next(); }, flow::LkParams::paper(), outputs.sinks());
 //   outputs.close();
@@ -24,15 +24,15 @@
 #include <vector>
 
 #include "pipeline/frame_graph.hpp"
-#include "stages/flow_file_sink.hpp"
-#include "stages/video_sink.hpp"
+#include "video/flow_file_sink.hpp"
+#include "video/video_sink.hpp"
 
 namespace roiflow::pipeline {
 
 struct DenseOutputOptions {
   std::string video;     // colour-coded flow: video file or PNG folder (VideoSink); empty = none
   std::string flow_dir;  // raw flow, one file per pair (FlowFileSink); empty = none
-  stages::FlowFileFormat flow_format = stages::FlowFileFormat::Flo;
+  video::FlowFileFormat flow_format = video::FlowFileFormat::Flo;
   double max_motion = 0;  // pixels at full colour saturation; 0 = each pair's robust maximum
 };
 
@@ -50,8 +50,8 @@ class DenseOutputs {
 
  private:
   float max_motion_ = -1.f;
-  std::unique_ptr<stages::VideoSink> video_;
-  std::unique_ptr<stages::FlowFileSink> flow_;
+  std::unique_ptr<video::VideoSink> video_;
+  std::unique_ptr<video::FlowFileSink> flow_;
 };
 
 }  // namespace roiflow::pipeline

@@ -192,7 +192,7 @@ class FrontEnd {
     }
     run_.enter(Stage::Source, seq_);
     const auto start = Clock::now();
-    std::optional<stages::Frame> frame = source_();
+    std::optional<video::Frame> frame = source_();
     if (!frame) {
       fc.stop();
       return {};
@@ -200,7 +200,7 @@ class FrontEnd {
     run_.time("decode", start);
     FrameMsg m;
     m.seq = seq_++;
-    m.frame = std::make_shared<const stages::Frame>(std::move(*frame));
+    m.frame = std::make_shared<const video::Frame>(std::move(*frame));
     m.pyramid = pool_->get();
     return m;
   }
@@ -287,12 +287,12 @@ const char* to_string(Stage stage) {
   return "?";
 }
 
-RunReport run_tracking(const FrameSource& source, stages::Tracker& tracker,
+RunReport run_tracking(const FrameSource& source, tracking::Tracker& tracker,
                        const std::vector<TrackSink>& sinks, const GraphOptions& options) {
   TrackStep step;
   step.levels = tracker.pyramid_levels();
   step.sigma = tracker.pyramid_sigma();
-  step.process = [&tracker](const stages::TrackerInput& in) { return tracker.process(in); };
+  step.process = [&tracker](const tracking::TrackerInput& in) { return tracker.process(in); };
   step.wants_pyramid = [&tracker] { return tracker.wants_pyramid(); };
   step.drain = [&tracker] { tracker.finish_background_work(); };
   return run_tracking(source, step, sinks, options);
@@ -312,7 +312,7 @@ RunReport run_tracking(const FrameSource& source, const TrackStep& step,
       TrackedFrame out;
       out.seq = m.seq;
       out.frame = m.frame;
-      out.output = std::make_shared<const stages::TrackerOutput>(step.process(
+      out.output = std::make_shared<const tracking::TrackerOutput>(step.process(
           {m.frame->index, m.frame->image, m.frame->gray,
            std::const_pointer_cast<const flow::Pyramid>(m.pyramid), m.frame->deferred_image}));
       run.time("track", t0);
@@ -458,7 +458,7 @@ RunReport run_dense(const FrameSource& source, const flow::LkParams& params,
   });
 }
 
-RunReport run_mot(const FrameSource& source, const stages::MultiTrackerParams& params,
+RunReport run_mot(const FrameSource& source, const tracking::MultiTrackerParams& params,
                   const std::vector<MotSink>& sinks, const GraphOptions& options) {
   params.validate();
   return run_in_arena(options, [&](int limit, Clock::time_point start) {
@@ -467,22 +467,22 @@ RunReport run_mot(const FrameSource& source, const stages::MultiTrackerParams& p
     FrontEnd front(g, run, source, limit, params.lk.levels, params.lk.sigma);
 
     // Background refresh: serial, in frame order (the model learns the frames in order).
-    stages::MotionDetector detector(params.detector);
+    tracking::MotionDetector detector(params.detector);
     tf::function_node<FrameMsg, SeenMsg> background(g, tf::serial, [&](const FrameMsg& m) {
       run.enter(Stage::Track, m.seq);
       const auto t0 = Clock::now();
       SeenMsg out;
       out.seq = m.seq;
       out.frame = m;
-      out.fg = std::make_shared<const stages::Foreground>(detector.observe(m.frame->picture()));
+      out.fg = std::make_shared<const tracking::Foreground>(detector.observe(m.frame->picture()));
       run.time("background", t0);
       return out;
     });
     // Global treatment: the moving objects of each frame, several frames at once.
     tf::function_node<SeenMsg, SeenMsg> global(g, tf::unlimited, [&](SeenMsg m) {
       const auto t0 = Clock::now();
-      m.detections = std::make_shared<const std::vector<stages::Detection>>(
-          stages::detect_objects(*m.fg, params.detector));
+      m.detections = std::make_shared<const std::vector<tracking::Detection>>(
+          tracking::detect_objects(*m.fg, params.detector));
       run.time("global", t0);
       return m;
     });
@@ -502,7 +502,7 @@ RunReport run_mot(const FrameSource& source, const stages::MultiTrackerParams& p
       work->before = std::get<1>(in);
       work->planned = t0;
       if (work->before.pyramid) {
-        work->tiles = stages::plan_tiles(*work->before.state, *work->before.fg, params);
+        work->tiles = tracking::plan_tiles(*work->before.state, *work->before.fg, params);
       }
       std::shared_ptr<const FrameWork> shared = work;
       run.time("plan", t0);
@@ -520,8 +520,8 @@ RunReport run_mot(const FrameSource& source, const stages::MultiTrackerParams& p
       std::unique_ptr<flow::DenseLK> lk = lk_pool.take();
       CollectMsg out{m.work, static_cast<long long>(m.tile), {}};
       out.motion =
-          stages::measure_tile(m.work->tiles[m.tile], *m.work->before.pyramid,
-                               *m.work->now.frame.pyramid, *m.work->before.fg, *lk, params);
+          tracking::measure_tile(m.work->tiles[m.tile], *m.work->before.pyramid,
+                                 *m.work->now.frame.pyramid, *m.work->before.fg, *lk, params);
       lk_pool.give_back(std::move(lk));
       run.time("lk", t0);
       return out;
@@ -571,7 +571,7 @@ RunReport run_mot(const FrameSource& source, const stages::MultiTrackerParams& p
     tf::make_edge(tf::output_port<0>(retire), front.retire_port());
 
     DecidedMsg seed;
-    seed.state = std::make_shared<const stages::TrackSet>(stages::initial_tracks(params));
+    seed.state = std::make_shared<const tracking::TrackSet>(tracking::initial_tracks(params));
     tf::input_port<1>(meet).try_put(seed);
     return finish(g, run, front, start);
   });

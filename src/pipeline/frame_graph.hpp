@@ -7,9 +7,9 @@
 // cancel flag stops the source and finishes the frames in flight. docs/ARCHITECTURE.md, "The
 // graphs", draws them.
 //
-//   roiflow::stages::VideoSource source("car.mp4");
+//   roiflow::video::VideoSource source("car.mp4");
 //   roiflow::pipeline::TbbExecutor tiles;  // LK over row tiles of the region
-//   roiflow::stages::Tracker tracker(roiflow::stages::TrackerParams{}, &tiles);
+//   roiflow::tracking::Tracker tracker(roiflow::tracking::TrackerParams{}, &tiles);
 //   roiflow::pipeline::GraphOptions options;
 //   options.threads = 4;
 //   const roiflow::pipeline::RunReport report = roiflow::pipeline::run_tracking(
@@ -30,14 +30,14 @@
 #include "flow/dense_lk.hpp"
 #include "flow/pyramid.hpp"
 #include "report/run_stats.hpp"
-#include "stages/multi_tracker.hpp"
-#include "stages/tracker.hpp"
-#include "stages/video_source.hpp"
+#include "tracking/multi_tracker.hpp"
+#include "tracking/tracker.hpp"
+#include "video/video_source.hpp"
 
 namespace roiflow::pipeline {
 
 // Frames in order; std::nullopt at the end. Called from one thread at a time.
-using FrameSource = std::function<std::optional<stages::Frame>()>;
+using FrameSource = std::function<std::optional<video::Frame>()>;
 
 // The stages a test hook sees, in the order a frame meets them.
 enum class Stage { Source, Pyramid, Track, Flow, Sink };
@@ -63,8 +63,8 @@ struct RunReport {
 
 struct TrackedFrame {
   long long seq = 0;  // 0-based order of arrival from the source
-  std::shared_ptr<const stages::Frame> frame;
-  std::shared_ptr<const stages::TrackerOutput> output;
+  std::shared_ptr<const video::Frame> frame;
+  std::shared_ptr<const tracking::TrackerOutput> output;
 };
 
 struct TrackSink {
@@ -72,7 +72,7 @@ struct TrackSink {
   std::function<void(const TrackedFrame&)> consume;
 };
 
-RunReport run_tracking(const FrameSource& source, stages::Tracker& tracker,
+RunReport run_tracking(const FrameSource& source, tracking::Tracker& tracker,
                        const std::vector<TrackSink>& sinks, const GraphOptions& options = {});
 
 // The same with any serial per-frame step in the tracker's place (it gets each frame with its
@@ -80,7 +80,7 @@ RunReport run_tracking(const FrameSource& source, stages::Tracker& tracker,
 struct TrackStep {
   int levels = 3;
   double sigma = 0.5;
-  std::function<stages::TrackerOutput(const stages::TrackerInput&)> process;
+  std::function<tracking::TrackerOutput(const tracking::TrackerInput&)> process;
   // Optional, thread-safe: false when the step does not want whole-frame pyramids for the next
   // frames (Tracker::wants_pyramid); those frames then come with a null pyramid. Empty: always.
   std::function<bool()> wants_pyramid;
@@ -96,8 +96,8 @@ RunReport run_tracking(const FrameSource& source, const TrackStep& step,
 
 struct FlowPair {
   long long seq = 0;  // sequence number of frame t (the first pair is 0)
-  std::shared_ptr<const stages::Frame> frame_t;
-  std::shared_ptr<const stages::Frame> frame_t1;
+  std::shared_ptr<const video::Frame> frame_t;
+  std::shared_ptr<const video::Frame> frame_t1;
   std::shared_ptr<const flow::FlowResult> flow;  // whole-frame flow t -> t+1
   // In FlowSink::consume: what that sink's `prepare` made of this pair (empty without one).
   cv::Mat prepared = {};
@@ -119,7 +119,7 @@ RunReport run_dense(const FrameSource& source, const flow::LkParams& params,
 
 // ------------------------------------------------------------------- multi-object tracking mode
 //
-// Every moving object of a fixed camera (stages/multi_tracker.hpp), on this graph:
+// Every moving object of a fixed camera (tracking/multi_tracker.hpp), on this graph:
 //
 //   front end ─► background (serial: MOG2 refresh) ─► global (detect_objects) ─► sequencer ─┐
 //                                                                                           ▼
@@ -137,8 +137,8 @@ RunReport run_dense(const FrameSource& source, const flow::LkParams& params,
 
 struct MotTrackedFrame {
   long long seq = 0;
-  std::shared_ptr<const stages::Frame> frame;
-  std::shared_ptr<const stages::MotFrame> output;
+  std::shared_ptr<const video::Frame> frame;
+  std::shared_ptr<const tracking::MotFrame> output;
 };
 
 struct MotSink {
@@ -147,7 +147,7 @@ struct MotSink {
 };
 
 // Stage times in options.stats: "pyramid", "background", "global", "plan", "lk", "decide".
-RunReport run_mot(const FrameSource& source, const stages::MultiTrackerParams& params,
+RunReport run_mot(const FrameSource& source, const tracking::MultiTrackerParams& params,
                   const std::vector<MotSink>& sinks, const GraphOptions& options = {});
 
 const char* to_string(Stage stage);

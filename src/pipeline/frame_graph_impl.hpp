@@ -12,9 +12,9 @@
 
 #include "flow/dense_lk.hpp"
 #include "flow/pyramid.hpp"
-#include "stages/motion_detector.hpp"
-#include "stages/multi_tracker.hpp"
-#include "stages/video_source.hpp"
+#include "tracking/motion_detector.hpp"
+#include "tracking/multi_tracker.hpp"
+#include "video/video_source.hpp"
 
 namespace roiflow::pipeline::frame_graph_impl {
 
@@ -27,7 +27,7 @@ inline double ms_since(Clock::time_point start) {
 // A decoded frame on its way through the pyramid levels.
 struct FrameMsg {
   long long seq = 0;
-  std::shared_ptr<const stages::Frame> frame;
+  std::shared_ptr<const video::Frame> frame;
   std::shared_ptr<flow::Pyramid> pyramid;  // filled level by level, then only read
 };
 
@@ -35,21 +35,21 @@ struct FrameMsg {
 struct SeenMsg {
   long long seq = 0;
   FrameMsg frame;
-  std::shared_ptr<const stages::Foreground> fg;
-  std::shared_ptr<const std::vector<stages::Detection>> detections;
+  std::shared_ptr<const tracking::Foreground> fg;
+  std::shared_ptr<const std::vector<tracking::Detection>> detections;
 };
 // The decisions at frame t, with what the plan of t+1 needs of frame t.
 struct DecidedMsg {
   long long seq = -1;
-  std::shared_ptr<const stages::TrackSet> state;
+  std::shared_ptr<const tracking::TrackSet> state;
   std::shared_ptr<const flow::Pyramid> pyramid;
-  std::shared_ptr<const stages::Foreground> fg;
+  std::shared_ptr<const tracking::Foreground> fg;
 };
 // One frame's work between plan and decision.
 struct FrameWork {
   SeenMsg now;
   DecidedMsg before;
-  std::vector<stages::ObjectTile> tiles;
+  std::vector<tracking::ObjectTile> tiles;
   Clock::time_point planned;
 };
 struct TileMsg {
@@ -60,11 +60,11 @@ struct TileMsg {
 struct CollectMsg {
   std::shared_ptr<const FrameWork> work;
   long long tile = -1;
-  stages::TileMotion motion;
+  tracking::TileMotion motion;
 };
 struct CollectedMsg {
   std::shared_ptr<const FrameWork> work;
-  std::vector<stages::TileMotion> motions;
+  std::vector<tracking::TileMotion> motions;
 };
 
 // Joins a frame's tile motions, which finish in any order: add() returns the frame's motions
@@ -72,7 +72,7 @@ struct CollectedMsg {
 class TileCollector {
  public:
   std::optional<CollectedMsg> add(const CollectMsg& m) {
-    std::vector<stages::TileMotion>& motions = pending_[m.work.get()];
+    std::vector<tracking::TileMotion>& motions = pending_[m.work.get()];
     if (m.tile >= 0) motions.push_back(m.motion);
     if (motions.size() != m.work->tiles.size()) return std::nullopt;
     CollectedMsg done{m.work, std::move(motions)};
@@ -81,7 +81,7 @@ class TileCollector {
   }
 
  private:
-  std::unordered_map<const FrameWork*, std::vector<stages::TileMotion>> pending_;
+  std::unordered_map<const FrameWork*, std::vector<tracking::TileMotion>> pending_;
 };
 
 // DenseLK objects of one run, for the dense flow nodes and the LK tile tasks: a task borrows one
@@ -115,17 +115,17 @@ class LkPool {
 
 // The decision at a frame from its tiles' motions: the new state and what the sinks see (each
 // object's region is the union of its tiles').
-inline std::pair<std::shared_ptr<const stages::TrackSet>, std::shared_ptr<stages::MotFrame>>
-decide_frame(const CollectedMsg& m, const stages::MultiTrackerParams& params) {
+inline std::pair<std::shared_ptr<const tracking::TrackSet>, std::shared_ptr<tracking::MotFrame>>
+decide_frame(const CollectedMsg& m, const tracking::MultiTrackerParams& params) {
   const SeenMsg& now = m.work->now;
   bool global_frame = false;
-  auto state = std::make_shared<const stages::TrackSet>(
-      stages::decide(*m.work->before.state, now.frame.frame->index, now.frame.frame->gray.size(),
-                     m.motions, *now.fg, *now.detections, params, &global_frame));
+  auto state = std::make_shared<const tracking::TrackSet>(
+      tracking::decide(*m.work->before.state, now.frame.frame->index, now.frame.frame->gray.size(),
+                       m.motions, *now.fg, *now.detections, params, &global_frame));
   auto out =
-      std::make_shared<stages::MotFrame>(stages::report_frame(*state, m.motions, global_frame));
-  for (stages::MotObject& o : out->objects) {
-    for (const stages::TileMotion& tm : m.motions) {
+      std::make_shared<tracking::MotFrame>(tracking::report_frame(*state, m.motions, global_frame));
+  for (tracking::MotObject& o : out->objects) {
+    for (const tracking::TileMotion& tm : m.motions) {
       const std::size_t ti = tm.track;
       if (ti < m.work->before.state->tracks.size() && m.work->before.state->tracks[ti].id == o.id)
         o.region |= tm.region;

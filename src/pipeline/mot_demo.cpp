@@ -49,9 +49,9 @@ MotDemoResult run_mot_demo(const MotDemoOptions& options) {
   result.summary_path = file("summary.json");
 
   long long next = 0;
-  const FrameSource source = [&]() -> std::optional<stages::Frame> {
+  const FrameSource source = [&]() -> std::optional<video::Frame> {
     if (next >= scene.frames()) return std::nullopt;
-    stages::Frame f;
+    video::Frame f;
     f.index = next;
     f.timestamp_s = static_cast<double>(next) / kFps;
     f.image = scene.render(next);

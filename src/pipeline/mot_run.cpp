@@ -12,26 +12,26 @@
 #include "report/annotate.hpp"
 #include "report/progress.hpp"
 #include "report/run_stats.hpp"
-#include "stages/track_log_sink.hpp"
-#include "stages/video_sink.hpp"
+#include "video/track_log_sink.hpp"
+#include "video/video_sink.hpp"
 
 namespace roiflow::pipeline {
 namespace {
 
-report::ObjectsAnnotation objects_annotation(const stages::MotFrame& f) {
+report::ObjectsAnnotation objects_annotation(const tracking::MotFrame& f) {
   report::ObjectsAnnotation a;
   a.index = f.index;
   a.born = f.born;
   a.ended = f.ended;
   a.global = f.global;
-  for (const stages::MotObject& o : f.objects)
+  for (const tracking::MotObject& o : f.objects)
     a.objects.push_back({o.id, o.box, o.velocity, o.lost, o.region});
   return a;
 }
 
 }  // namespace
 
-eval::MotBox mot_box(long long index, const stages::MotObject& o) {
+eval::MotBox mot_box(long long index, const tracking::MotObject& o) {
   eval::MotBox b;
   b.frame = static_cast<int>(index + 1);
   b.id = static_cast<int>(o.id);
@@ -43,20 +43,20 @@ eval::MotBox mot_box(long long index, const stages::MotObject& o) {
 MotRun track_objects(const FrameSource& source, cv::Size size, double fps,
                      const MotRunOptions& options) {
   options.params.validate();
-  std::optional<stages::TrackLogWriter> log;
+  std::optional<video::TrackLogWriter> log;
   if (!options.log.empty()) log.emplace(options.log);
-  std::optional<stages::VideoSink> video;
+  std::optional<video::VideoSink> video;
   if (!options.video.empty()) video.emplace(options.video, fps, size);
   report::Progress progress(std::cerr, options.frame_hint,
                             options.progress && report::Progress::stderr_is_terminal());
 
   std::vector<eval::MotBox> mot_boxes;
   long long lost_records = 0, object_frames = 0, most_objects = 0;
-  stages::MotFrame last;
+  tracking::MotFrame last;
   std::vector<MotSink> sinks;
   sinks.push_back({"log", [&](const MotTrackedFrame& f) {
                      long long found = 0;
-                     for (const stages::MotObject& o : f.output->objects) {
+                     for (const tracking::MotObject& o : f.output->objects) {
                        if (o.lost) {
                          ++lost_records;
                        } else {
@@ -125,13 +125,13 @@ MotRun track_objects(const FrameSource& source, cv::Size size, double fps,
   return run;
 }
 
-std::vector<stages::KnownTarget> known_targets(const std::vector<std::string>& boxes,
-                                               const std::string& file) {
-  std::vector<stages::KnownTarget> known;
+std::vector<tracking::KnownTarget> known_targets(const std::vector<std::string>& boxes,
+                                                 const std::string& file) {
+  std::vector<tracking::KnownTarget> known;
   if (!file.empty()) {
     if (!boxes.empty()) throw UsageError("--init-file: give the targets either there or by --init");
     try {
-      return stages::read_known_targets(file);
+      return tracking::read_known_targets(file);
     } catch (const Error& e) {
       throw UsageError(std::string("--init-file: ") + e.what());
     }
@@ -146,10 +146,10 @@ std::vector<stages::KnownTarget> known_targets(const std::vector<std::string>& b
   return known;
 }
 
-MotRun track_objects_video(stages::VideoSource& source, const MotRunOptions& options) {
+MotRun track_objects_video(video::VideoSource& source, const MotRunOptions& options) {
   const cv::Rect2f frame(0.f, 0.f, static_cast<float>(source.size().width),
                          static_cast<float>(source.size().height));
-  for (const stages::KnownTarget& k : options.params.known) {
+  for (const tracking::KnownTarget& k : options.params.known) {
     const cv::Rect2f inside = k.box & frame;
     if (inside.width < 2 || inside.height < 2)
       throw UsageError(
@@ -158,10 +158,10 @@ MotRun track_objects_video(stages::VideoSource& source, const MotRunOptions& opt
   MotRunOptions o = options;
   o.frame_hint = source.frame_count_hint();
   MotRun run = track_objects([&] { return source.next(); }, source.size(), source.fps(), o);
-  const stages::SourceStatus& status = source.status();
-  run.end = run.report.cancelled                                    ? RunEnd::Cancelled
-            : status.state == stages::SourceStatus::State::kStopped ? RunEnd::InputStopped
-                                                                    : RunEnd::Complete;
+  const video::SourceStatus& status = source.status();
+  run.end = run.report.cancelled                                   ? RunEnd::Cancelled
+            : status.state == video::SourceStatus::State::kStopped ? RunEnd::InputStopped
+                                                                   : RunEnd::Complete;
   const Ending end = ending(run.end, run.report.frames, status.message);
   run.summary["input"] = source.description();
   run.summary["status"] = end.message.empty() ? status.message : end.message;

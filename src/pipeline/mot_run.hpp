@@ -2,7 +2,7 @@
 // column, the MOTChallenge file, the annotated video and the summary.
 //
 //   using namespace roiflow;
-//   stages::VideoSource source("vtest.avi", {});
+//   video::VideoSource source("vtest.avi", {});
 //   pipeline::MotRunOptions o;                       // fixed camera, every moving object
 //   o.log = "track.csv";                             // frame,id,x,y,w,h,vx,vy,mode,lost,ms
 //   o.mot = "mot.txt";                               // frame,id,x,y,w,h,conf,-1,-1,-1
@@ -26,13 +26,13 @@
 #include "eval/mot.hpp"
 #include "pipeline/frame_graph.hpp"
 #include "pipeline/signals.hpp"
-#include "stages/multi_tracker.hpp"
-#include "stages/video_source.hpp"
+#include "tracking/multi_tracker.hpp"
+#include "video/video_source.hpp"
 
 namespace roiflow::pipeline {
 
 struct MotRunOptions {
-  stages::MultiTrackerParams params;
+  tracking::MultiTrackerParams params;
   std::string log;    // track log (.csv or .json); empty = none
   std::string mot;    // MOTChallenge file; empty = none
   std::string video;  // annotated video or PNG folder; empty = none
@@ -56,13 +56,13 @@ MotRun track_objects(const FrameSource& source, cv::Size size, double fps,
 
 // The known targets of `roiflow track`: each "x,y,w,h" of `boxes` (ids 1, 2, ...) or the
 // id,x,y,w,h lines of `file` (one of the two at most). Throws UsageError on bad text.
-std::vector<stages::KnownTarget> known_targets(const std::vector<std::string>& boxes,
-                                               const std::string& file);
+std::vector<tracking::KnownTarget> known_targets(const std::vector<std::string>& boxes,
+                                                 const std::string& file);
 
 // track_objects over a video: throws UsageError before the first frame when a known target has
 // less than 2x2 pixels inside the frame; the summary gets "input" and "status" (the source's,
 // or how the run ended), and `end` says how it ended.
-MotRun track_objects_video(stages::VideoSource& source, const MotRunOptions& options);
+MotRun track_objects_video(video::VideoSource& source, const MotRunOptions& options);
 
 // The summary for people: frames, rates, global activations, lost records, threads, objects
 // born and ended; lines ending in '\n'.
@@ -70,6 +70,6 @@ std::string objects_summary_text(const std::string& what, const nlohmann::ordere
 
 // An object of frame `index` (0-based) as a MOTChallenge box: frame index + 1, the top-left
 // corner plus one (MOTChallenge counts pixels from 1), confidence 1 (eval::write_mot writes it).
-eval::MotBox mot_box(long long index, const stages::MotObject& object);
+eval::MotBox mot_box(long long index, const tracking::MotObject& object);
 
 }  // namespace roiflow::pipeline

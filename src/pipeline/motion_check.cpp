@@ -32,13 +32,13 @@ MotionCheck check_motion(const FrameSource& video, const std::vector<eval::Track
       c.violations.push_back({id, it->second.first, it->second.last, it->second.what});
     open.erase(it);
   };
-  stages::MotionDetector detector(params.detector);
-  while (std::optional<stages::Frame> f = video()) {
+  tracking::MotionDetector detector(params.detector);
+  while (std::optional<video::Frame> f = video()) {
     ++c.frames;
     const cv::Mat picture = f->picture();
     const cv::Rect2f view(0.f, 0.f, static_cast<float>(picture.cols),
                           static_cast<float>(picture.rows));
-    const stages::Foreground fg = detector.observe(picture);
+    const tracking::Foreground fg = detector.observe(picture);
     const long long frame = c.frames;  // 1-based, as the log counts
     std::set<long long> bad_now;
     const auto it = by_frame.find(frame);

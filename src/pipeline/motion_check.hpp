@@ -1,12 +1,12 @@
 // Motion check: does every object a track log reports as found move with moving pixels?
 //
 //   using namespace roiflow;
-//   stages::VideoSource video("vtest.avi");
+//   video::VideoSource video("vtest.avi");
 //   const auto log = eval::read_track_csv("track.csv");
 //   pipeline::MotionCheck c = pipeline::check_motion([&] { return video.next(); }, log);
 //   if (!c.violations.empty()) std::cout << c.violations[0].id << "\n";
 //
-// The video is played through a background model of its own (stages::MotionDetector, the
+// The video is played through a background model of its own (tracking::MotionDetector, the
 // tracker's defaults), independent of the tracker's. For each object, the check counts runs of
 // consecutive frames where the log reports it found (local and not lost) while its box holds
 // almost no moving pixels (share at most `still_share`) or its part inside the frame has a side
@@ -20,7 +20,7 @@
 
 #include "eval/track_log.hpp"
 #include "pipeline/frame_graph.hpp"
-#include "stages/motion_detector.hpp"
+#include "tracking/motion_detector.hpp"
 
 namespace roiflow::pipeline {
 
@@ -28,8 +28,8 @@ struct MotionCheckParams {
   // The check's own model of moving pixels: OpenCV's MOG2 background (ratio 0.9, which calls
   // fewer pixels moving than the tracker's, and no ghost absorption), so that the check does not
   // follow the tracker's tuning.
-  stages::MotionDetectorParams detector = [] {
-    stages::MotionDetectorParams p;
+  tracking::MotionDetectorParams detector = [] {
+    tracking::MotionDetectorParams p;
     p.background_ratio = 0.9;
     p.ghost_frames = 0;  // the model's own foreground: no ghost absorbed
     p.start_frames = 0;  // nor the background its first frames uncover

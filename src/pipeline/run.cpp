@@ -13,8 +13,8 @@
 #include "pipeline/tbb_executor.hpp"
 #include "report/annotate.hpp"
 #include "report/progress.hpp"
-#include "stages/track_log_sink.hpp"
-#include "stages/video_sink.hpp"
+#include "video/track_log_sink.hpp"
+#include "video/video_sink.hpp"
 
 namespace roiflow::pipeline {
 namespace {
@@ -26,7 +26,7 @@ double stage_ms(const std::vector<report::StageTotal>& stages, const char* name)
   return 0.0;
 }
 
-report::TrackAnnotation track_annotation(const stages::TrackerOutput& out) {
+report::TrackAnnotation track_annotation(const tracking::TrackerOutput& out) {
   report::TrackAnnotation a;
   a.index = out.index;
   a.has_target = out.has_target;
@@ -49,9 +49,9 @@ GraphOptions graph_options(int threads, int max_in_flight, const std::atomic<boo
   return options;
 }
 
-RunEnd run_end(const RunReport& report, const stages::SourceStatus* status) {
+RunEnd run_end(const RunReport& report, const video::SourceStatus* status) {
   if (report.cancelled) return RunEnd::Cancelled;
-  if (status != nullptr && status->state == stages::SourceStatus::State::kStopped) {
+  if (status != nullptr && status->state == video::SourceStatus::State::kStopped) {
     return RunEnd::InputStopped;
   }
   return RunEnd::Complete;
@@ -59,8 +59,8 @@ RunEnd run_end(const RunReport& report, const stages::SourceStatus* status) {
 
 }  // namespace
 
-stages::VideoSourceParams source_params(const SourceOptions& options) {
-  stages::VideoSourceParams p;
+video::VideoSourceParams source_params(const SourceOptions& options) {
+  video::VideoSourceParams p;
   p.start = options.start;
   p.max_frames = options.max_frames;
   p.decode_threads = options.decode_threads;
@@ -73,10 +73,10 @@ stages::VideoSourceParams source_params(const SourceOptions& options) {
 TrackSummary run_track_stream(const FrameSource& frames, const StreamInfo& info,
                               const TrackRunOptions& options) {
   TbbExecutor tiles;
-  stages::Tracker tracker(options.tracker, &tiles);
-  std::optional<stages::TrackLogWriter> log;
+  tracking::Tracker tracker(options.tracker, &tiles);
+  std::optional<video::TrackLogWriter> log;
   if (!options.log.empty()) log.emplace(options.log);
-  std::optional<stages::VideoSink> video;
+  std::optional<video::VideoSink> video;
   if (!options.video.empty()) video.emplace(options.video, info.fps, info.size);
   report::Progress progress(std::cerr, info.frame_hint,
                             options.progress && report::Progress::stderr_is_terminal());
@@ -107,7 +107,7 @@ TrackSummary run_track_stream(const FrameSource& frames, const StreamInfo& info,
 
   s.stages = stats.totals();
   const double tracker_ms = stage_ms(s.stages, "pyramid") + stage_ms(s.stages, "track");
-  s.mode = stages::to_string(options.tracker.mode);
+  s.mode = tracking::to_string(options.tracker.mode);
   s.input = info.description;
   s.end = run_end(report, nullptr);
   s.frames = report.frames;
@@ -136,12 +136,12 @@ void check_init_inside(const std::optional<cv::Rect2f>& init, cv::Size size, flo
   }
 }
 
-TrackSummary run_track_video(stages::VideoSource& source, const TrackRunOptions& options) {
+TrackSummary run_track_video(video::VideoSource& source, const TrackRunOptions& options) {
   check_init_inside(options.tracker.init, source.size(), 2.f);
   const StreamInfo info{source.size(), source.fps(), source.frame_count_hint(),
                         source.description()};
   TrackSummary s = run_track_stream([&] { return source.next(); }, info, options);
-  if (s.end == RunEnd::Complete && source.status().state == stages::SourceStatus::State::kStopped) {
+  if (s.end == RunEnd::Complete && source.status().state == video::SourceStatus::State::kStopped) {
     s.end = RunEnd::InputStopped;
   }
   s.status = source.status().message;
@@ -150,14 +150,14 @@ TrackSummary run_track_video(stages::VideoSource& source, const TrackRunOptions&
 
 void check_track_outputs(const std::string& log, const std::string& video,
                          const std::string& summary, const std::string& mot) {
-  if (!log.empty()) stages::check_track_log_path(log, "--log");
+  if (!log.empty()) video::check_track_log_path(log, "--log");
   for (const auto& [path, option] :
        {std::pair{&mot, "--mot"}, {&video, "--out"}, {&summary, "--summary"}}) {
     if (!path->empty()) check_output_path(*path, option);
   }
 }
 
-DenseSummary run_dense_video(stages::VideoSource& source, const DenseRunOptions& options) {
+DenseSummary run_dense_video(video::VideoSource& source, const DenseRunOptions& options) {
   DenseOutputOptions wanted;
   wanted.video = options.video;
   wanted.flow_dir = options.flow_dir;

@@ -5,7 +5,7 @@
 // Each returns what the run measured (frames, rates, per-stage times, peak memory, how it ended);
 // turning that into text or JSON is the caller's business.
 //
-//   roiflow::stages::VideoSource source("car.mp4", roiflow::pipeline::source_params({}));
+//   roiflow::video::VideoSource source("car.mp4", roiflow::pipeline::source_params({}));
 //   roiflow::pipeline::TrackRunOptions options;
 //   options.tracker.init = cv::Rect2f(10, 20, 40, 30);
 //   options.log = "track.csv";
@@ -22,9 +22,9 @@
 #include "eval/track_log.hpp"
 #include "pipeline/frame_graph.hpp"
 #include "report/run_stats.hpp"
-#include "stages/flow_file_sink.hpp"
-#include "stages/tracker.hpp"
-#include "stages/video_source.hpp"
+#include "tracking/tracker.hpp"
+#include "video/flow_file_sink.hpp"
+#include "video/video_source.hpp"
 
 namespace roiflow::pipeline {
 
@@ -35,7 +35,7 @@ struct SourceOptions {
   int decode_threads = 0;    // a video's FFmpeg decoder threads; 0 = automatic
 };
 // The VideoSource parameters of a run: colour is converted only for the frames that need it.
-stages::VideoSourceParams source_params(const SourceOptions& options);
+video::VideoSourceParams source_params(const SourceOptions& options);
 
 // A stream that is not a VideoSource (a generated scene): its frames and what a run must know.
 struct StreamInfo {
@@ -53,7 +53,7 @@ enum class RunEnd {
 };
 
 struct TrackRunOptions {
-  stages::TrackerParams tracker;
+  tracking::TrackerParams tracker;
   int threads = 1;
   int max_in_flight = 0;      // frames decoded ahead at most; 0 = 2 x threads + 2
   std::string log;            // track log (.csv or .json); empty = none
@@ -85,7 +85,7 @@ struct TrackSummary {
 
 // Throws UsageError, before the first frame is tracked, when less than 2x2 pixels of
 // options.tracker.init lie inside the frame.
-TrackSummary run_track_video(stages::VideoSource& source, const TrackRunOptions& options);
+TrackSummary run_track_video(video::VideoSource& source, const TrackRunOptions& options);
 TrackSummary run_track_stream(const FrameSource& frames, const StreamInfo& info,
                               const TrackRunOptions& options);
 // Throws UsageError when less than `min_side` x `min_side` pixels of `init` (any part of it when
@@ -103,7 +103,7 @@ struct DenseRunOptions {
   int max_in_flight = 0;
   std::string video;     // colour-coded flow: a video or a folder of PNGs; empty = none
   std::string flow_dir;  // raw flow, one file per pair; empty = none (one of the two is needed)
-  stages::FlowFileFormat flow_format = stages::FlowFileFormat::Flo;
+  video::FlowFileFormat flow_format = video::FlowFileFormat::Flo;
   double max_motion = 0;  // pixels at full colour saturation; 0 = each pair's robust maximum
   bool progress = false;
   const std::atomic<bool>* cancel = nullptr;
@@ -124,6 +124,6 @@ struct DenseSummary {
   std::vector<report::StageTotal> stages;
 };
 
-DenseSummary run_dense_video(stages::VideoSource& source, const DenseRunOptions& options);
+DenseSummary run_dense_video(video::VideoSource& source, const DenseRunOptions& options);
 
 }  // namespace roiflow::pipeline

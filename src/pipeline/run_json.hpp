@@ -2,7 +2,7 @@
 // --summary` write): every field of the typed summary, in a fixed order, with the per-stage
 // times as report::stages_json gives them; and a tracking run's two lines for people.
 //
-//   roiflow::stages::VideoSource source("synthetic:10");
+//   roiflow::video::VideoSource source("synthetic:10");
 //   const auto s = roiflow::pipeline::run_track_video(source, {});
 //   nlohmann::ordered_json doc = roiflow::pipeline::to_json(s);
 //   doc["input"] = s.input;  // callers add what their document needs beyond the run's figures

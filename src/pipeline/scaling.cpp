@@ -15,8 +15,8 @@
 #include "pipeline/mot_run.hpp"
 #include "pipeline/tbb_executor.hpp"
 #include "report/run_stats.hpp"
-#include "stages/tracker.hpp"
-#include "stages/video_source.hpp"
+#include "tracking/tracker.hpp"
+#include "video/video_source.hpp"
 
 namespace roiflow::pipeline {
 namespace {
@@ -34,10 +34,10 @@ Measured run_once(const ScalingOptions& o, int threads) {
   // start) at `threads`.
   const tbb::global_control cap(tbb::global_control::max_allowed_parallelism,
                                 static_cast<std::size_t>(threads));
-  stages::VideoSourceParams source_params;
+  video::VideoSourceParams source_params;
   source_params.max_frames = o.max_frames;
   source_params.defer_colour = true;
-  stages::VideoSource source(o.input, source_params);
+  video::VideoSource source(o.input, source_params);
   const FrameSource frames = [&] { return source.next(); };
 
   report::RunStats stats;
@@ -64,12 +64,12 @@ Measured run_once(const ScalingOptions& o, int threads) {
         run.summary.at("tracker_ms_per_frame").get<double>() * static_cast<double>(report.frames);
     m.frames = report.frames;
   } else {
-    stages::TrackerParams params;
+    tracking::TrackerParams params;
     params.lk = o.lk;
     params.mode =
-        o.mode == ScalingMode::Global ? stages::TrackMode::Global : stages::TrackMode::Local;
+        o.mode == ScalingMode::Global ? tracking::TrackMode::Global : tracking::TrackMode::Local;
     TbbExecutor tiles;
-    stages::Tracker tracker(params, &tiles);
+    tracking::Tracker tracker(params, &tiles);
     report = run_tracking(frames, tracker, {}, graph);
     const nlohmann::ordered_json s = stats.to_json(report.wall_s);
     m.tracker_ms = report::stage_ms_total(s, "pyramid") + report::stage_ms_total(s, "track");

@@ -17,7 +17,7 @@
 // timed). The work per mode:
 //  - Local: fixed-camera tracking of every moving object (pipeline::track_objects, as
 //    `roiflow track` without --init): motion detection, per-object LK tiles, decisions.
-//  - Global: the single-object tracker (stages::Tracker) with the global treatment on every
+//  - Global: the single-object tracker (tracking::Tracker) with the global treatment on every
 //    frame.
 //  - Dense: dense LK between every pair of frames (run_dense).
 // fps is frames (dense: pairs) per second of wall time; tracker_fps counts only the time inside
@@ -43,7 +43,7 @@ const char* to_string(ScalingMode mode);
 ScalingMode scaling_mode_from_string(const std::string& text);
 
 struct ScalingOptions {
-  std::string input;         // anything stages::VideoSource opens (synthetic:... included)
+  std::string input;         // anything video::VideoSource opens (synthetic:... included)
   std::vector<int> threads;  // thread counts, each 1..kMaxThreads, no repeats; run in this order
   ScalingMode mode = ScalingMode::Local;
   flow::LkParams lk = flow::LkParams::paper();

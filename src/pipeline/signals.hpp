@@ -4,7 +4,7 @@
 // signal after a signal, 1 after an input that stopped mid-stream, else 0.
 //
 //   roiflow::pipeline::SignalScope signals;
-//   roiflow::stages::VideoSource source("synthetic:100");
+//   roiflow::video::VideoSource source("synthetic:100");
 //   roiflow::pipeline::TrackRunOptions options;
 //   options.cancel = roiflow::pipeline::cancel_flag();
 //   const auto s = roiflow::pipeline::run_track_video(source, options);

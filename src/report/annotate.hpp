@@ -45,7 +45,7 @@ struct AnnotateStyle {
 cv::Mat annotate_frame(const cv::Mat& image, const TrackAnnotation& out,
                        const AnnotateStyle& style = {});
 
-// Every object of a multi-object frame (stages::MotFrame, filled by the pipeline):
+// Every object of a multi-object frame (tracking::MotFrame, filled by the pipeline):
 //
 //   roiflow::report::ObjectsAnnotation a;
 //   a.objects.push_back({3, {70, 51, 30, 80}, {2.f, 0.f}, false, {}});

@@ -23,9 +23,9 @@
 #include "flow/dense_lk.hpp"
 #include "gst_roiflow.hpp"
 #include "scene_video.hpp"
-#include "stages/object_tracker.hpp"
-#include "stages/video_source.hpp"
 #include "test_util.hpp"
+#include "tracking/object_tracker.hpp"
+#include "video/video_source.hpp"
 
 namespace roiflow {
 namespace {
@@ -150,7 +150,7 @@ GstHarness* harness(const std::string& description) {
 
 class GstTest : public test::TempDirTest {};
 
-// GRAY8: one meta per frame, id 1, the same boxes as stages::ObjectTracker on the same frames,
+// GRAY8: one meta per frame, id 1, the same boxes as tracking::ObjectTracker on the same frames,
 // and the track log `roiflow track` would write (roiflow score reads it).
 TEST_F(GstTest, TrackMetasEqualObjectTrackerAndLog) {
   const eval::TrackingScene s = scene(30);
@@ -161,10 +161,10 @@ TEST_F(GstTest, TrackMetasEqualObjectTrackerAndLog) {
 
   // The box as the element parses it from its text.
   const auto parsed = [](float v) { return static_cast<float>(std::stod(std::to_string(v))); };
-  stages::ObjectTrackerParams params;
+  tracking::ObjectTrackerParams params;
   params.init = {cv::Rect2f(parsed(s.box(0).x), parsed(s.box(0).y), parsed(s.box(0).width),
                             parsed(s.box(0).height))};
-  stages::ObjectTracker reference(params);
+  tracking::ObjectTracker reference(params);
   std::vector<std::string> expected_log;
   for (int i = 0; i < s.frames(); ++i) {
     const cv::Mat bgr = s.render(i);
@@ -174,10 +174,10 @@ TEST_F(GstTest, TrackMetasEqualObjectTrackerAndLog) {
     const std::vector<Roi> got = rois(out);
     gst_buffer_unref(out);
 
-    stages::TrackerInput in;
+    tracking::TrackerInput in;
     in.index = i;
     cv::cvtColor(bgr, in.gray, cv::COLOR_BGR2GRAY);
-    const std::vector<stages::TrackedObject> want = reference.update(in);
+    const std::vector<tracking::TrackedObject> want = reference.update(in);
     eval::TrackRecord r = reference.primary().record();
     r.ms = 0;
     expected_log.push_back(eval::track_csv_row(r));
@@ -459,12 +459,12 @@ TEST_F(GstTest, StateChangesReleaseEverything) {
 // where the object was found.
 std::size_t expect_log_equals_cli(const std::string& video, const std::string& log) {
   const std::vector<eval::TrackRecord> records = eval::read_track_csv(log);
-  stages::VideoSourceParams source_params;
+  video::VideoSourceParams source_params;
   source_params.defer_colour = true;
-  stages::VideoSource source(video, source_params);
-  stages::ObjectTracker reference(stages::ObjectTrackerParams{});
+  video::VideoSource source(video, source_params);
+  tracking::ObjectTracker reference(tracking::ObjectTrackerParams{});
   std::size_t i = 0, found = 0, differ = 0;
-  while (std::optional<stages::Frame> f = source.next()) {
+  while (std::optional<video::Frame> f = source.next()) {
     reference.update({f->index, f->image, f->gray, nullptr, f->deferred_image});
     eval::TrackRecord want = reference.primary().record();
     if (i >= records.size()) break;

@@ -22,7 +22,8 @@ run_step("cmake --install" ${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${pr
 # What the package promises is in place.
 foreach(file bin/roiflow include/roiflow/core/error.hpp include/roiflow/flow/dense_lk.hpp
              include/roiflow/eval/flo_io.hpp include/roiflow/report/plot.hpp
-             include/roiflow/stages/tracker.hpp include/roiflow/pipeline/frame_graph.hpp)
+             include/roiflow/video/video_source.hpp include/roiflow/tracking/tracker.hpp
+             include/roiflow/pipeline/frame_graph.hpp)
   if(NOT EXISTS ${prefix}/${file})
     message(FATAL_ERROR "install consumer: ${prefix}/${file} was not installed")
   endif()

@@ -38,9 +38,9 @@ class ShiftingSource {
                                       {0, 0}, 5)
                    .frame0;
   }
-  std::optional<stages::Frame> operator()() {
+  std::optional<video::Frame> operator()() {
     if (next_ >= count_) return std::nullopt;
-    stages::Frame f;
+    video::Frame f;
     f.index = next_;
     f.timestamp_s = static_cast<double>(next_) / 25.0;
     // dst(x) = texture(x - t): content at texture point p shows at p + t, t moving by
@@ -87,9 +87,9 @@ TrackStep recording_step(std::vector<long long>& seen, int levels) {
   TrackStep step;
   step.levels = levels;
   step.sigma = 0.5;
-  step.process = [&seen](const stages::TrackerInput& in) {
+  step.process = [&seen](const tracking::TrackerInput& in) {
     seen.push_back(in.index);
-    stages::TrackerOutput out;
+    tracking::TrackerOutput out;
     out.index = in.index;
     out.has_target = in.pyramid != nullptr && in.pyramid->num_levels() > 0;
     return out;
@@ -133,9 +133,9 @@ TEST_P(FrameGraphThreads, PyramidsEqualTheSerialBuild) {
   TrackStep step;
   step.levels = 4;
   step.sigma = 0.8;
-  step.process = [&](const stages::TrackerInput& in) {
+  step.process = [&](const tracking::TrackerInput& in) {
     built.push_back(*in.pyramid);
-    return stages::TrackerOutput{};
+    return tracking::TrackerOutput{};
   };
   GraphOptions options;
   options.threads = GetParam();
@@ -155,7 +155,7 @@ TEST_P(FrameGraphThreads, DenseDeliversEveryPairInOrderAndEqualsTheSerialFlow) {
   constexpr long long kFrames = 16;
   ShiftingSource source({96, 72}, kFrames);
   ShiftingSource reference({96, 72}, kFrames);
-  std::vector<stages::Frame> frames;
+  std::vector<video::Frame> frames;
   while (auto f = reference())
     frames.push_back(*f);
   const flow::LkParams params = flow::LkParams::paper();
@@ -275,20 +275,20 @@ TEST_P(FrameGraphThreads, TheTrackerGivesTheSerialResult) {
   scene_params.jump_frame = 60;
   const eval::TrackingScene scene(scene_params);
   auto frame = [&](int i) {
-    stages::Frame f;
+    video::Frame f;
     f.index = i;
     f.image = scene.render(i);
     cv::cvtColor(f.image, f.gray, cv::COLOR_BGR2GRAY);
     return f;
   };
-  stages::TrackerParams params;
+  tracking::TrackerParams params;
   params.observe_interval = 4;  // many refreshes in a short run
 
-  std::vector<stages::TrackerOutput> serial;
+  std::vector<tracking::TrackerOutput> serial;
   {
-    stages::Tracker tracker(params);
+    tracking::Tracker tracker(params);
     for (int i = 0; i < scene.frames(); ++i) {
-      const stages::Frame f = frame(i);
+      const video::Frame f = frame(i);
       serial.push_back(tracker.process({f.index, f.image, f.gray, nullptr, f.deferred_image}));
     }
   }
@@ -298,18 +298,18 @@ TEST_P(FrameGraphThreads, TheTrackerGivesTheSerialResult) {
   // tracker's refresh jobs and a sink ask for it on different threads.
   int next = 0;
   TbbExecutor tiles;
-  stages::Tracker tracker(params, &tiles);
-  std::vector<stages::TrackerOutput> piped;
+  tracking::Tracker tracker(params, &tiles);
+  std::vector<tracking::TrackerOutput> piped;
   std::atomic<int> made{0};
   long long pictures_checked = 0;
   GraphOptions options;
   options.threads = GetParam();
   run_tracking(
-      [&]() -> std::optional<stages::Frame> {
+      [&]() -> std::optional<video::Frame> {
         if (next >= scene.frames()) return std::nullopt;
-        stages::Frame f = frame(next++);
+        video::Frame f = frame(next++);
         const cv::Mat bgr = std::exchange(f.image, cv::Mat());
-        f.deferred_image = std::make_shared<const stages::DeferredImage>([bgr, &made] {
+        f.deferred_image = std::make_shared<const video::DeferredImage>([bgr, &made] {
           ++made;
           return bgr.clone();
         });
@@ -527,7 +527,7 @@ TEST(FrameGraph, RejectsBadOptions) {
 }
 
 TEST(FrameGraph, EmptySourceIsAnEmptyRun) {
-  FrameSource empty = [] { return std::optional<stages::Frame>(); };
+  FrameSource empty = [] { return std::optional<video::Frame>(); };
   std::vector<long long> seen;
   EXPECT_EQ(run_tracking(empty, recording_step(seen, 3), {}).frames, 0);
   EXPECT_EQ(run_dense(empty, flow::LkParams::paper(), {}).frames, 0);

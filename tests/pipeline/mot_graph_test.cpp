@@ -13,8 +13,8 @@
 
 #include "mot_scene.hpp"
 #include "pipeline/frame_graph.hpp"
-#include "stages/multi_tracker.hpp"
 #include "test_util.hpp"
+#include "tracking/multi_tracker.hpp"
 
 namespace roiflow::pipeline {
 namespace {
@@ -24,9 +24,9 @@ using test::MotScene;
 
 FrameSource scene_source(const MotScene& scene, int frames, std::atomic<int>* produced = nullptr) {
   auto next = std::make_shared<int>(0);
-  return [&scene, frames, next, produced]() -> std::optional<stages::Frame> {
+  return [&scene, frames, next, produced]() -> std::optional<video::Frame> {
     if (*next >= frames) return std::nullopt;
-    stages::Frame f;
+    video::Frame f;
     f.index = *next;
     f.image = scene.frame(*next);
     cv::cvtColor(f.image, f.gray, cv::COLOR_BGR2GRAY);
@@ -48,10 +48,10 @@ MotScene busy_scene(int count) {
   return MotScene({640, 200 + 90 * ((count - 1) / 8)}, objects);
 }
 
-using Frames = std::vector<std::vector<stages::MotObject>>;
+using Frames = std::vector<std::vector<tracking::MotObject>>;
 
-Frames serial(const MotScene& scene, int frames, const stages::MultiTrackerParams& p) {
-  stages::MultiTracker tracker(p);
+Frames serial(const MotScene& scene, int frames, const tracking::MultiTrackerParams& p) {
+  tracking::MultiTracker tracker(p);
   Frames out;
   for (int t = 0; t < frames; ++t) {
     const cv::Mat bgr = scene.frame(t);
@@ -79,7 +79,7 @@ void expect_same(const Frames& a, const Frames& b) {
 TEST(MotGraph, SameResultsAsTheSerialTrackerAtAnyThreadCount) {
   const MotScene scene = busy_scene(16);
   const int frames = 50;
-  stages::MultiTrackerParams p;
+  tracking::MultiTrackerParams p;
   p.tile_rows = 16;  // several tiles per object: the per-frame join is exercised
   const Frames reference = serial(scene, frames, p);
   long long found = 0;
@@ -118,7 +118,7 @@ TEST(MotGraph, SameResultsAsTheSerialTrackerAtAnyThreadCount) {
 TEST(MotGraph, KnownTargetsKeepTheirIds) {
   const MotScene scene({240, 160},
                        {{{20, 40, 24, 40}, {2, 0}, 0}, {{180, 90, 24, 40}, {-2, 0}, 0}});
-  stages::MultiTrackerParams p;
+  tracking::MultiTrackerParams p;
   p.known = {{5, scene.box(0, 0)}, {8, scene.box(1, 0)}};
   p.births = false;
   std::set<long long> ids;
