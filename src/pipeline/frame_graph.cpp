@@ -458,6 +458,45 @@ RunReport run_dense(const FrameSource& source, const flow::LkParams& params,
   });
 }
 
+namespace {
+
+// The scene start's flow: dense LK from each frame back to the previous one while the detector
+// wants the frames' motion (tracking::wants_flow: its first frames), serial and in frame order,
+// ahead of the background refresh. It holds the previous frame's pyramid only while the next
+// frame wants it.
+class StartFlowNode {
+ public:
+  StartFlowNode(tf::graph& g, Run& run, const tracking::MultiTrackerParams& params)
+      : params_(params),
+        lk_(params.lk),
+        node_(g, tf::serial, [this, &run](const FrameMsg& m) { return step(run, m); }) {}
+  tf::function_node<FrameMsg, StartMsg>& node() { return node_; }
+
+ private:
+  StartMsg step(Run& run, const FrameMsg& m) {
+    StartMsg out{m.seq, m, nullptr};
+    if (tracking::wants_flow(params_.detector, m.seq) && previous_ && m.pyramid) {
+      run.enter(Stage::Flow, m.seq);
+      const auto t0 = Clock::now();
+      auto back = std::make_shared<flow::FlowResult>();
+      lk_.calc(*m.pyramid, *previous_, *back);
+      out.back = std::move(back);
+      run.time("start_flow", t0);
+    }
+    const bool more = tracking::wants_flow(params_.detector, m.seq + 1);
+    if (!more && previous_) lk_.collectGarbage();  // the scene start is over
+    previous_ = more ? m.pyramid : nullptr;
+    return out;
+  }
+
+  const tracking::MultiTrackerParams& params_;
+  flow::DenseLK lk_;
+  std::shared_ptr<flow::Pyramid> previous_;
+  tf::function_node<FrameMsg, StartMsg> node_;
+};
+
+}  // namespace
+
 RunReport run_mot(const FrameSource& source, const tracking::MultiTrackerParams& params,
                   const std::vector<MotSink>& sinks, const GraphOptions& options) {
   params.validate();
@@ -466,15 +505,15 @@ RunReport run_mot(const FrameSource& source, const tracking::MultiTrackerParams&
     tf::graph g;
     FrontEnd front(g, run, source, limit, params.lk.levels, params.lk.sigma);
 
-    // Background refresh: serial, in frame order (the model learns the frames in order).
+    StartFlowNode start_flow(g, run, params);  // the scene start's flow, then
+    // background refresh: serial, in frame order (the model learns the frames in order).
     tracking::MotionDetector detector(params.detector);
-    tf::function_node<FrameMsg, SeenMsg> background(g, tf::serial, [&](const FrameMsg& m) {
+    tf::function_node<StartMsg, SeenMsg> background(g, tf::serial, [&](const StartMsg& m) {
       run.enter(Stage::Track, m.seq);
       const auto t0 = Clock::now();
-      SeenMsg out;
-      out.seq = m.seq;
-      out.frame = m;
-      out.fg = std::make_shared<const tracking::Foreground>(detector.observe(m.frame->picture()));
+      SeenMsg out{m.seq, m.frame, nullptr, nullptr};
+      out.fg = std::make_shared<const tracking::Foreground>(
+          detector.observe(m.frame.frame->picture(), m.back.get()));
       run.time("background", t0);
       return out;
     });
@@ -552,7 +591,8 @@ RunReport run_mot(const FrameSource& source, const tracking::MultiTrackerParams&
     auto sink_nodes = make_sink_nodes<MotTrackedFrame>(g, run, sinks, 0);
     RetireNode retire = make_retire_node(g, run, static_cast<int>(sink_nodes.size()));
 
-    tf::make_edge(front.output(), background);
+    tf::make_edge(front.output(), start_flow.node());
+    tf::make_edge(start_flow.node(), background);
     tf::make_edge(background, global);
     tf::make_edge(global, seen_order);
     tf::make_edge(seen_order, tf::input_port<0>(meet));

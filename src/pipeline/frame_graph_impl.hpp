@@ -31,6 +31,14 @@ struct FrameMsg {
   std::shared_ptr<flow::Pyramid> pyramid;  // filled level by level, then only read
 };
 
+// A frame with, in the scene start (tracking::wants_flow), its dense flow back to the previous
+// frame (the global treatment's motion); else no flow.
+struct StartMsg {
+  long long seq = 0;
+  FrameMsg frame;
+  std::shared_ptr<const flow::FlowResult> back;
+};
+
 // A frame after the background refresh and the global treatment.
 struct SeenMsg {
   long long seq = 0;

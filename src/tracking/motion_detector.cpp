@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/background_segm.hpp>
 #include <string>
@@ -10,6 +11,7 @@
 
 #include "core/error.hpp"
 #include "core/text.hpp"
+#include "tracking/start_motion_impl.hpp"
 
 namespace roiflow::tracking {
 
@@ -42,6 +44,12 @@ void MotionDetectorParams::validate() const {
     fail("change_level must be in (0, 255), got " + number_text(change_level));
   if (!(background_ratio > 0 && background_ratio <= 1))
     fail("background_ratio must be in (0, 1], got " + number_text(background_ratio));
+  if (!(start_motion >= 0 && start_motion <= 100))
+    fail("start_motion must be in [0, 100], got " + number_text(start_motion));
+  if (!(start_texture >= 0 && start_texture <= 100))
+    fail("start_texture must be in [0, 100], got " + number_text(start_texture));
+  if (!(start_reach >= 0 && start_reach <= 100))
+    fail("start_reach must be in [0, 100], got " + number_text(start_reach));
   if (!(merge_overlap > 0 && merge_overlap <= 1))
     fail("merge_overlap must be in (0, 1], got " + number_text(merge_overlap));
 }
@@ -213,8 +221,8 @@ void fill_start_holes(cv::Mat& mask, cv::Mat& moving, const cv::Mat& settled, co
 // change test): absorbed like a ghost at once, and settled. After the start the model has
 // learnt more than its first frame and every pixel is left to it.
 long long absorb_ghosts(cv::Mat& mask, const cv::Mat& gray, const cv::Mat& old,
-                        const cv::Mat& changed, const MotionDetectorParams& params,
-                        PixelState& st) {
+                        const cv::Mat& changed, const cv::Mat& flow_motion, const cv::Mat& textured,
+                        int scale, const MotionDetectorParams& params, PixelState& st) {
   const int frames = params.ghost_frames, start_frames = params.start_frames;
   const double level = params.change_level;
   if (st.quiet.size() != mask.size()) {
@@ -224,8 +232,22 @@ long long absorb_ghosts(cv::Mat& mask, const cv::Mat& gray, const cv::Mat& old,
     st.absorbed_gray = cv::Mat::zeros(mask.size(), CV_8U);
   }
   const bool start = ++st.frames <= start_frames;
+  const bool by_flow = start && !flow_motion.empty();
   cv::Mat motion, moving;
-  if (start) {
+  if (by_flow) {
+    // The flow tells each pixel's own motion, less the reach of its window, and a still pixel is
+    // background whether or not it changed lately (the object that stood there has just left).
+    // Motion counts only in a textured window: elsewhere LK keeps the coarser levels' motion (a
+    // uniform road beside a walker takes the walker's motion). Stillness does not need texture:
+    // the coarser levels of a uniform body moving carry its motion, those of background none.
+    motion = detail::flow_motion_state(flow_motion, params.start_motion);
+    motion.setTo(0, (motion == 2) & ~textured);
+    cv::compare(motion, 2, moving, cv::CMP_EQ);
+    const int reach = static_cast<int>(std::lround(params.start_reach / scale));
+    if (reach > 0)
+      cv::erode(moving, moving,
+                cv::getStructuringElement(cv::MORPH_RECT, {2 * reach + 1, 2 * reach + 1}));
+  } else if (start) {
     motion = motion_state(gray, old, kStillShift);
     // Where it moved, less the reach of the window and the blur beyond the moving pixels.
     cv::compare(motion, 2, moving, cv::CMP_EQ);
@@ -249,7 +271,7 @@ long long absorb_ghosts(cv::Mat& mask, const cv::Mat& gray, const cv::Mat& old,
         else
           a[x] = 0;
       }
-      if (start && se[x] == 0 && m[x] != 0 && c[x] == 0 && mv[x] == 1) {
+      if (start && m[x] != 0 && mv[x] == 1 && (by_flow || (se[x] == 0 && c[x] == 0))) {
         se[x] = 1;  // absorbed at its gray level
         a[x] = 1;
         ag[x] = g[x];
@@ -261,7 +283,10 @@ long long absorb_ghosts(cv::Mat& mask, const cv::Mat& gray, const cv::Mat& old,
         ++q[x];
     }
   }
-  if (start) fill_start_holes(mask, moving, st.settled, gray, old, level, params);
+  if (by_flow)
+    mask |= moving;
+  else if (start)
+    fill_start_holes(mask, moving, st.settled, gray, old, level, params);
   if (frames <= 0) return cv::countNonZero(st.absorbed);
   cv::Mat labels, stats, centroids;
   const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
@@ -310,7 +335,15 @@ MotionDetector::MotionDetector(const MotionDetectorParams& params)
   impl_->model->setBackgroundRatio(params_.background_ratio);
 }
 
-Foreground MotionDetector::observe(const cv::Mat& image) {
+bool wants_flow(const MotionDetectorParams& params, long long index) {
+  return params.start_motion > 0 && index >= 1 && index <= params.start_frames;
+}
+
+bool MotionDetector::wants_flow() const {
+  return tracking::wants_flow(params_, impl_->observed);
+}
+
+Foreground MotionDetector::observe(const cv::Mat& image, const flow::FlowResult* flow_back) {
   if (image.empty() || image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3))
     throw Error("motion detector: frame must be 8-bit gray or BGR");
   Impl& s = *impl_;
@@ -358,8 +391,22 @@ Foreground MotionDetector::observe(const cv::Mat& image) {
     cv::Mat diff;
     cv::absdiff(gray, old, diff);
     cv::threshold(diff, diff, params_.change_level, 1, cv::THRESH_BINARY);
+    cv::Mat textured;
+    const bool flow_given = params_.start_motion > 0 && s.observed - 1 <= params_.start_frames &&
+                            flow_back != nullptr && !flow_back->flow.empty();
+    if (flow_given) {
+      const flow::FlowResult& fb = *flow_back;
+      if (fb.flow.type() != CV_32FC2 || fb.flow.size() != s.frame_size ||
+          fb.confidence.type() != CV_32F || fb.confidence.size() != s.frame_size)
+        throw Error("motion detector: the flow must be CV_32FC2 with its confidence, frame-sized");
+      fg.motion = detail::relative_motion(fb.flow, fb.confidence, gray.size(),
+                                          params_.start_texture, textured);
+    }
     if (params_.ghost_frames > 0 || params_.start_frames > 0) {
-      fg.absorbed = absorb_ghosts(fg.mask, gray, old, diff, params_, s.pixels);
+      fg.absorbed =
+          absorb_ghosts(fg.mask, gray, old, diff, fg.motion, textured, s.scale, params_, s.pixels);
+      if (!fg.motion.empty())
+        fg.motion.setTo(cv::Scalar::all(std::numeric_limits<float>::quiet_NaN()), ~textured);
     }
     cv::integral(diff, fg.changed, CV_32S);
   }
@@ -469,7 +516,7 @@ std::vector<cv::Rect2f> merge_nested(std::vector<cv::Rect2f> boxes, double overl
 
 std::vector<Detection> detect_objects(const Foreground& fg, const MotionDetectorParams& params) {
   std::vector<Detection> out;
-  if (fg.empty() || fg.observed <= params.warmup) return out;
+  if (fg.empty() || (fg.observed <= params.warmup && fg.motion.empty())) return out;
   // A fresh buffer: the closing must not write into fg.mask (shared, read by other threads).
   cv::Mat mask;
   if (params.close <= 0) mask = fg.mask;
@@ -482,7 +529,8 @@ std::vector<Detection> detect_objects(const Foreground& fg, const MotionDetector
   const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
   const float s = static_cast<float>(fg.scale);
   const double min_small = params.min_area / (static_cast<double>(fg.scale) * fg.scale);
-  std::vector<cv::Rect2f> boxes;
+  // The boxes of distinct motions are not merged with the others: two objects crossing overlap.
+  std::vector<cv::Rect2f> boxes, by_motion;
   for (int i = 1; i < n; ++i) {
     const int w = stats.at<int>(i, cv::CC_STAT_WIDTH), h = stats.at<int>(i, cv::CC_STAT_HEIGHT);
     // Speckle that survived the opening is dropped before the merge.
@@ -490,7 +538,15 @@ std::vector<Detection> detect_objects(const Foreground& fg, const MotionDetector
     std::vector<cv::Rect> parts;
     const cv::Rect whole(stats.at<int>(i, cv::CC_STAT_LEFT), stats.at<int>(i, cv::CC_STAT_TOP), w,
                          h);
-    if (params.split_valley > 0) {
+    const int min_pixels = std::max(8, static_cast<int>(0.25 * min_small));
+    if (!fg.motion.empty() &&
+        detail::split_by_motion(labels, fg.mask, fg.motion, i, whole, params.start_motion,
+                                min_pixels, params.merge_overlap, parts)) {
+      for (const cv::Rect& r : parts)
+        by_motion.emplace_back(static_cast<float>(r.x) * s, static_cast<float>(r.y) * s,
+                               static_cast<float>(r.width) * s, static_cast<float>(r.height) * s);
+      continue;
+    } else if (params.split_valley > 0) {
       split_blob(labels, fg.mask, i, whole, params.split_valley, params.split_width, 0, parts);
     } else {
       parts.push_back(whole);
@@ -502,8 +558,9 @@ std::vector<Detection> detect_objects(const Foreground& fg, const MotionDetector
   }
   const cv::Rect2f frame(0.f, 0.f, static_cast<float>(fg.frame_size.width),
                          static_cast<float>(fg.frame_size.height));
-  for (const cv::Rect2f& b :
-       merge_nested(std::move(boxes), params.merge_overlap, params.join_gap)) {
+  boxes = merge_nested(std::move(boxes), params.merge_overlap, params.join_gap);
+  boxes.insert(boxes.end(), by_motion.begin(), by_motion.end());
+  for (const cv::Rect2f& b : boxes) {
     const cv::Rect2f box = b & frame;
     if (box.area() < params.min_area) continue;
     out.push_back({box, (box.tl() + box.br()) * 0.5f, box.area()});

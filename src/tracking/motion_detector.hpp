@@ -14,8 +14,11 @@
 // foreground mask with its integral image; a part of it that has not changed for
 // `ghost_frames` frames (a ghost, or an object that stopped) is absorbed into the background at
 // once, until its gray level changes. With `start_frames`, in the first frames (the model learnt
-// its first frame, moving objects included, as background) the motion of each pixel's
-// neighbourhood decides instead: moving is foreground, provably still is background.
+// its first frame, moving objects included, as background) motion decides instead: moving is
+// foreground, still is background. With `start_motion` the motion is the frames' dense flow (the
+// paper's global treatment: a fixed camera's background does not move), and a part of the
+// foreground whose pixels move in distinct ways is one object per motion (two vehicles crossing);
+// else it is each neighbourhood's change against a few frames back.
 // detect_objects() is the global treatment proper and
 // keeps no state, so a pipeline runs it beside the next frame's refresh: morphology (an opening
 // removes speckle, a closing joins the parts of one object), connected components, the boxes of
@@ -27,6 +30,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "flow/dense_lk.hpp"
 #include "tracking/global_detector.hpp"
 
 namespace roiflow::tracking {
@@ -47,6 +51,22 @@ struct MotionDetectorParams {
                                   // an object uncovered (absorbed like a ghost); 0 = none. About a
                                   // second of video: by then the model (learning at 1/frames
                                   // early on) weighs its first frame under 1/30
+  double start_motion = 0.5;      // scene start with the frames' flow (observe's `back`):
+                                  // a pixel whose motion differs from the frame's median motion
+                                  // (a fixed camera's: about zero) by at least this many pixels
+                                  // a frame moves and is foreground, one within half of it
+                                  // stands still and is background (a ghost is absorbed at
+                                  // once), and a part of the foreground whose moving pixels
+                                  // hold several distinct motions splits into one object per
+                                  // motion; detections start with the second frame. 0 = off
+  double start_reach = 5;         // full-resolution pixels a moving object's flow reaches
+                                  // beyond its edge (half the LK window): the moving pixels are
+                                  // eroded by it, >= 0
+  double start_texture = 1.0;     // the flow decides only where its window is at least this
+                                  // many times as textured (smallest structure eigenvalue) as
+                                  // the frame's median window; elsewhere LK holds the coarser
+                                  // levels' motion, which spreads an object's motion over a
+                                  // uniform background around it, >= 0 (0 = everywhere)
   double background_ratio = 0.5;  // MOG2's background: its heaviest modes that together hold this
                                   // share of the recent frames, (0, 1]. OpenCV's 0.9 takes for
                                   // background any colour seen 10% of the time: the body of a
@@ -88,6 +108,10 @@ struct Foreground {
   // The model's foreground also holds ghosts: background that an object uncovered after
   // standing in it (or since the first frame); a ghost does not change.
   cv::Mat changed;
+  // Scene start with the frames' flow: per pixel (model resolution, CV_32FC2) its motion since
+  // the previous frame less the frame's median motion, in full-resolution pixels (NaN where the
+  // window is too weakly textured to tell, MotionDetectorParams::start_texture); else empty.
+  cv::Mat motion;
   long long absorbed = 0;  // pixels (model resolution) held as absorbed ghosts in this frame
 
   // Share of moving pixels inside `box` (full-resolution pixels, clipped to the frame); 0 for
@@ -104,13 +128,24 @@ class MotionDetector {
   const MotionDetectorParams& params() const { return params_; }
   // The background refresh: updates the model with `image` (8-bit BGR or gray, one size for a
   // run, in order) and returns its foreground. Throws roiflow::Error on a size change.
-  Foreground observe(const cv::Mat& image);
+  // `back` (given when wants_flow() said so, else ignored): dense LK from this frame back to the
+  // previous one over the whole frame, flow (CV_32FC2: per pixel of `image` its displacement to
+  // the previous frame) and confidence (CV_32F, the window's smallest structure eigenvalue).
+  Foreground observe(const cv::Mat& image, const flow::FlowResult* back = nullptr);
+  // Whether the next observe() is in the scene start and uses the flow back to the previous
+  // frame (from the second frame to the `start_frames`-th one after it, when `start_motion` > 0).
+  bool wants_flow() const;
 
  private:
   MotionDetectorParams params_;
   struct Impl;
   std::shared_ptr<Impl> impl_;
 };
+
+// Whether frame `index` (0-based, in the order observed) is in the scene start and takes the
+// flow back to the previous frame: MotionDetector::wants_flow() for a pipeline that computes that
+// flow ahead of the background refresh.
+bool wants_flow(const MotionDetectorParams& params, long long index);
 
 // The moving objects of one foreground (score = area in full-resolution pixels), biggest first;
 // empty during the warm-up. Thread-safe (reads only `fg`).

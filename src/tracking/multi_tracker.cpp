@@ -651,7 +651,13 @@ MotFrame MultiTracker::process(long long index, const cv::Mat& gray, const cv::M
   if (s.started && gray.size() != s.state.size)
     throw Error("multi-object tracker: frame size changed");
   flow::build_pyramid(gray, s.params.lk.levels, s.params.lk.sigma, s.pyr_cur);
-  Foreground fg = s.detector.observe(image.empty() ? gray : image);
+  // Scene start: the flow of this frame back to the previous one (the global treatment's motion).
+  flow::FlowResult back;
+  if (s.started && s.detector.wants_flow()) {
+    s.lk.calc(s.pyr_cur, s.pyr_prev, back);
+  }
+  Foreground fg =
+      s.detector.observe(image.empty() ? gray : image, back.flow.empty() ? nullptr : &back);
   const std::vector<Detection> detections = detect_objects(fg, s.params.detector);
   std::vector<TileMotion> motions;
   if (s.started) {
