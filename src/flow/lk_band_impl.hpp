@@ -57,9 +57,12 @@ std::size_t scratch_floats(const LevelJob& L) {
 }
 
 // Columns per step of a row pass: every stage (warp, pairs, window terms and sums, prefix sums,
-// solve) runs over one chunk before the next, so that a row's intermediate data stays in the
-// first-level cache; only the ring and the vertical sums come from further away.
-constexpr int kChunk = 256;
+// solve) runs over one chunk before the next. A chunk is a whole row up to 4096 columns: a
+// stage then reads what the one before stored a row's length earlier, long out of the store
+// queue (the solve's loads of the prefix sums just stored waited for them with shorter
+// chunks), and each stage's set-up is paid once per row. A row's intermediate data stays in the
+// second-level cache.
+constexpr int kChunk = 4096;
 
 // One iteration of one band: rows [first, end) of its output from its input.
 class RowPass {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <limits>
 #include <opencv2/imgproc.hpp>
@@ -277,6 +278,26 @@ class TwoLanes final : public Executor {
  private:
   Order order_;
 };
+
+// A row pass steps along a row in chunks of a few thousand columns. A frame that repeats every
+// 400 columns gets the same flow at the end of the first chunk as two periods to the left of it
+// (a vector left unsolved, or a sum carried wrongly from one chunk to the next, would not).
+TEST(DenseLkTest, RowsWiderThanOneChunkAreSolvedAlike) {
+  cv::Mat a;
+  cv::repeat(texture(cv::Size(400, 40), 5), 1, 11, a);
+  cv::Mat b;
+  const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0, 0.7, 0, 1, -0.4);
+  cv::warpAffine(a, b, shift, a.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT);
+  for (const test::NamedParams& c : test::lk_configurations()) {
+    const FlowResult r = dense_flow(a, b, c.params);
+    ASSERT_EQ(r.flow.size(), a.size()) << c.name;
+    ASSERT_TRUE(all_finite(r.flow)) << c.name;
+    const cv::Rect near_end(3900, 0, 400, a.rows);
+    const double gap =
+        cv::norm(r.flow(near_end), r.flow(near_end - cv::Point(800, 0)), cv::NORM_INF);
+    EXPECT_LT(gap, 1e-3) << c.name;
+  }
+}
 
 TEST(DenseLkTest, TwoChainsOfBandsGiveTheSerialResultBitForBit) {
   for (const cv::Size size : {cv::Size(192, 160), cv::Size(131, 203), cv::Size(64, 40)}) {
