@@ -1,4 +1,5 @@
 #include "pipeline/frame_graph.hpp"
+#include "tracking/motion_split.hpp"
 
 #include <oneapi/tbb/flow_graph.h>
 #include <oneapi/tbb/info.h>
@@ -495,6 +496,43 @@ class StartFlowNode {
   tf::function_node<FrameMsg, StartMsg> node_;
 };
 
+// The motion split (after the scene start) of the detections the objects at t say are wrong
+// (tracking::split_candidates): dense LK over each one's box, serial (frames meet their
+// decisions one at a time), between the meeting of frame t+1 with the decisions at t and the plan.
+class SplitNode {
+ public:
+  using Met = std::tuple<SeenMsg, DecidedMsg>;
+  SplitNode(tf::graph& g, Run& run, const tracking::MultiTrackerParams& params)
+      : params_(params),
+        lk_(params.lk),
+        node_(g, tf::serial, [this, &run](Met in) { return step(run, std::move(in)); }) {}
+  tf::function_node<Met, Met>& node() { return node_; }
+
+ private:
+  Met step(Run& run, Met in) {
+    SeenMsg& now = std::get<0>(in);
+    const DecidedMsg& before = std::get<1>(in);
+    if (!before.pyramid || !before.state || !now.detections || !now.fg) return in;
+    const std::vector<std::size_t> which =
+        tracking::split_candidates(*before.state, *now.detections, *now.fg, params_);
+    if (which.empty()) return in;
+    run.enter(Stage::Flow, now.seq);
+    const auto t0 = Clock::now();
+    std::vector<std::vector<cv::Rect2f>> parts;
+    for (std::size_t j : which)
+      parts.push_back(tracking::split_by_flow((*now.detections)[j].box, *before.pyramid,
+                                              *now.frame.pyramid, *now.fg, lk_, params_));
+    now.detections = std::make_shared<const std::vector<tracking::Detection>>(
+        tracking::apply_splits(*now.detections, which, parts));
+    run.time("split", t0);
+    return in;
+  }
+
+  const tracking::MultiTrackerParams& params_;
+  flow::DenseLK lk_;
+  tf::function_node<Met, Met> node_;
+};
+
 }  // namespace
 
 RunReport run_mot(const FrameSource& source, const tracking::MultiTrackerParams& params,
@@ -527,9 +565,9 @@ RunReport run_mot(const FrameSource& source, const tracking::MultiTrackerParams&
     });
     tf::sequencer_node<SeenMsg> seen_order(
         g, [](const SeenMsg& m) { return static_cast<std::size_t>(m.seq); });
-    // Frame t+1 meets the decisions at t: the feedback edge.
+    // Frame t+1 meets the decisions at t (the feedback edge), then the motion split.
     tf::join_node<std::tuple<SeenMsg, DecidedMsg>, tf::queueing> meet(g);
-
+    SplitNode split(g, run, params);
     using PlanNode =
         tf::multifunction_node<std::tuple<SeenMsg, DecidedMsg>, std::tuple<TileMsg, CollectMsg>>;
     PlanNode plan(g, tf::serial, [&](const std::tuple<SeenMsg, DecidedMsg>& in, auto& ports) {
@@ -596,7 +634,8 @@ RunReport run_mot(const FrameSource& source, const tracking::MultiTrackerParams&
     tf::make_edge(background, global);
     tf::make_edge(global, seen_order);
     tf::make_edge(seen_order, tf::input_port<0>(meet));
-    tf::make_edge(meet, plan);
+    tf::make_edge(meet, split.node());
+    tf::make_edge(split.node(), plan);
     tf::make_edge(tf::output_port<0>(plan), lk_tiles);
     tf::make_edge(tf::output_port<1>(plan), collect);
     tf::make_edge(lk_tiles, collect);

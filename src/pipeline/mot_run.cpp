@@ -104,7 +104,7 @@ MotRun track_objects(const FrameSource& source, cv::Size size, double fps,
   const nlohmann::ordered_json s = stats.to_json(run.report.wall_s);
   double tracker_ms = 0;
   for (const char* stage :
-       {"pyramid", "start_flow", "background", "global", "plan", "lk", "decide"})
+       {"pyramid", "start_flow", "background", "global", "split", "plan", "lk", "decide"})
     tracker_ms += report::stage_ms_total(s, stage);
   const double frames = static_cast<double>(run.report.frames);
   run.summary = {{"mode", "objects"},

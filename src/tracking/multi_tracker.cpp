@@ -1,5 +1,7 @@
 #include "tracking/multi_tracker.hpp"
 
+#include "tracking/motion_split.hpp"
+
 // 8x8 matrices gain nothing from Eigen's vector code, and GCC 12 warns (falsely) inside its
 // AVX-512 paths under -march=native.
 #define EIGEN_DONT_VECTORIZE
@@ -70,6 +72,10 @@ void MultiTrackerParams::validate() const {
   lk.validate();
   if (lk_context < -1 || lk_context > 1000)
     fail("lk_context must be in -1..1000, got " + number_text(lk_context));
+  if (!(split_grow == 0 || (split_grow >= 1 && split_grow <= 1000)))
+    fail("split_grow must be 0 or in [1, 1000], got " + number_text(split_grow));
+  if (!(split_keep > 0 && split_keep <= 1))
+    fail("split_keep must be in (0, 1], got " + number_text(split_keep));
   if (margin < 0 || margin > 1000) fail("margin must be in 0..1000, got " + number_text(margin));
   if (tile_rows < 8 || tile_rows > 4096)
     fail("tile_rows must be in 8..4096, got " + number_text(tile_rows));
@@ -658,9 +664,18 @@ MotFrame MultiTracker::process(long long index, const cv::Mat& gray, const cv::M
   }
   Foreground fg =
       s.detector.observe(image.empty() ? gray : image, back.flow.empty() ? nullptr : &back);
-  const std::vector<Detection> detections = detect_objects(fg, s.params.detector);
+  std::vector<Detection> detections = detect_objects(fg, s.params.detector);
   std::vector<TileMotion> motions;
   if (s.started) {
+    // The motion split of the detections the objects say are wrong (after the scene start).
+    const std::vector<std::size_t> which = split_candidates(s.state, detections, fg, s.params);
+    if (!which.empty()) {
+      std::vector<std::vector<cv::Rect2f>> parts;
+      for (std::size_t j : which)
+        parts.push_back(
+            split_by_flow(detections[j].box, s.pyr_prev, s.pyr_cur, fg, s.lk, s.params));
+      detections = apply_splits(detections, which, parts);
+    }
     for (const ObjectTile& tile : plan_tiles(s.state, s.fg_prev, s.params))
       motions.push_back(measure_tile(tile, s.pyr_prev, s.pyr_cur, s.fg_prev, s.lk, s.params));
   } else {

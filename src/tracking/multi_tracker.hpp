@@ -19,7 +19,9 @@
 //    overlapping box are not the object's own (in a crossing they move with the one in front)
 //    and are left out. Thread-safe; one task per tile.
 //  - MotionDetector::observe and detect_objects (tracking/motion_detector.hpp): the background
-//    refresh and the global treatment (moving objects of the frame).
+//    refresh and the global treatment (moving objects of the frame); after the scene start,
+//    split_candidates and split_by_flow (tracking/motion_split.hpp) cut a detection much larger
+//    than the one object it holds by its pixels' dense flow.
 //  - decide(state at t, the frame's tile motions, foreground, detections) -> state at t+1: per
 //    object a constant-velocity Kalman filter on its box (centre, size and their velocities; the
 //    paper's Fig. 3 correction), predicted, then corrected by the detection the optimal
@@ -83,6 +85,13 @@ struct MultiTrackerParams {
                                 // takes it, (0, 1]
   double lk_size_decay = 0.9;   // per frame an object follows LK alone, its size's speed is
                                 // multiplied by this, [0, 1]
+  double split_grow = 1.25;     // after the scene start, a detection over half of one object's
+                                // predicted box (and of no other) and this many times its area
+                                // is split by its pixels' motion (tracking/motion_split.hpp);
+                                // 0 = never, else >= 1
+  double split_keep = 0.7;      // the split keeps one motion's box alone (the rest of the
+                                // detection standing still is cut) when it covers under this
+                                // share of the detection, (0, 1]
   double min_moving = 0.08;     // share of moving pixels a box needs to count as moving, [0, 1)
   double min_changed = 0.02;    // and share of changed pixels (Foreground::changed: a ghost of
                                 // the background model has none), [0, 1); a detection with

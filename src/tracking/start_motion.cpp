@@ -66,9 +66,9 @@ cv::Mat flow_motion_state(const cv::Mat& motion, double moving) {
   return state;
 }
 
-bool split_by_motion(const cv::Mat& labels, const cv::Mat& mask, const cv::Mat& motion, int label,
-                     const cv::Rect& whole, double moving, int min_pixels, double overlap,
-                     std::vector<cv::Rect>& out) {
+std::vector<cv::Rect> motion_modes(const cv::Mat& labels, const cv::Mat& mask,
+                                   const cv::Mat& motion, int label, const cv::Rect& whole,
+                                   double moving, int min_pixels) {
   std::vector<cv::Point> points;
   std::vector<cv::Vec2f> velocity;
   const float m2 = static_cast<float>(moving * moving);
@@ -133,6 +133,14 @@ bool split_by_motion(const cv::Mat& labels, const cv::Mat& mask, const cv::Mat& 
     if (taken < min_pixels) break;
     boxes.push_back(box);
   }
+  return boxes;
+}
+
+bool split_by_motion(const cv::Mat& labels, const cv::Mat& mask, const cv::Mat& motion, int label,
+                     const cv::Rect& whole, double moving, int min_pixels, double overlap,
+                     std::vector<cv::Rect>& out) {
+  const std::vector<cv::Rect> boxes =
+      motion_modes(labels, mask, motion, label, whole, moving, min_pixels);
   // A part moving otherwise inside another's box (a walker's legs) is not an object of its own.
   std::vector<cv::Rect2f> merged(boxes.begin(), boxes.end());
   merged = merge_nested(std::move(merged), overlap);

@@ -30,6 +30,13 @@ cv::Mat relative_motion(const cv::Mat& back_flow, const cv::Mat& confidence, cv:
 // where by under half of that (it stands still), 0 between or where the motion is NaN.
 cv::Mat flow_motion_state(const cv::Mat& motion, double moving);
 
+// The boxes of the distinct motions of the component `label` of `labels` over `whole`
+// (split_by_motion's modes, below), densest first, before the nested ones merge; none when no
+// motion has `min_pixels` pixels.
+std::vector<cv::Rect> motion_modes(const cv::Mat& labels, const cv::Mat& mask,
+                                   const cv::Mat& motion, int label, const cv::Rect& whole,
+                                   double moving, int min_pixels);
+
 // The distinct motions of the component `label` of `labels` over `whole` (model resolution): its
 // pixels that move (`mask` set, `motion` at least `moving`; NaN never does) gather around a few
 // velocities. The densest velocity (a histogram of 1-pixel bins, each bin with its 8 neighbours)
