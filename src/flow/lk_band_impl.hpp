@@ -46,7 +46,8 @@ Layout layout_of(const LevelJob& L) {
   s.col_pad = round_up(-L.lo, 16);
   s.col_stride = round_up(s.col_pad + wp + L.hi + 1, 16);
   s.prefix = s.col + kChannels * s.col_stride;
-  s.prefix_pad = round_up(1 - L.lo, 16);
+  // (Two vectors more: the windowed output stores vector x's windows at x - 2N.)
+  s.prefix_pad = round_up(1 - L.lo, 16) + 2 * Native::N;
   s.prefix_stride = round_up(s.prefix_pad + wp + L.hi + Native::N, 16);
   s.total = s.prefix + kChannels * s.prefix_stride;
   return s;
@@ -87,6 +88,7 @@ class RowPass {
     acc_ = scratch + s_.acc;
     col_ = scratch + s_.col + s_.col_pad;
     prefix_ = scratch + s_.prefix + s_.prefix_pad;
+    win_ = Native::kPermute2 && !L.half ? window_width(L.lo, L.hi, Native::N) : 0;
     // The zeros before column 0 that windows clipped at the left border read (the scratch held
     // another level's layout before).
     for (int c = 0; c < kChannels; ++c) {
@@ -152,6 +154,8 @@ class RowPass {
     const bool solve = y >= 0 && flow;
     const bool half = solve && L.half;
     TermRows t;
+    t.w = w;
+    t.lo = L.lo;
     int deriv = kOutside;
     int fresh = -1, fresh_slot = 0;  // the row warped chunk by chunk, if any
     if (s >= 0 && s < L.h) {
@@ -180,7 +184,7 @@ class RowPass {
     }
     // Fresh sums on every stripe row, solved or not: the running sums below depend on them.
     const bool resum = y >= 0 && y % L.stripe == 0;
-    const EnterFn enter = pick_enter(deriv, L.inv_s2 > 0.f, leaving, solve && !resum, half);
+    const EnterFn enter = pick_enter(deriv, L.inv_s2 > 0.f, leaving, solve && !resum, half, win_);
     const float* top = half ? ring_row(y + L.lo) : nullptr;
     float* ring = ring_row(s);
     const float* resum_rows[64];
@@ -207,9 +211,10 @@ class RowPass {
       q.vn = row_v(out_, y);
       q.conf = conf_ ? conf_ + static_cast<Idx>(y) * conf_stride_ : nullptr;
       q.flow = flow_ ? flow_ + static_cast<Idx>(y) * flow_stride_ : nullptr;
+      q.windowed = win_ != 0;
     }
-    for (int c = 0; c < kChannels * N; ++c)
-      carry_[c] = 0.f;
+    for (int c = 0; c < (win_ != 0 ? kCarryVectors : kChannels); ++c)
+      Native::store(carry_ + c * N, Native::set1(0.f));
     if (fresh >= 0) warp_chunk(fresh, fresh_slot, 0, imin(kChunk, w));
     int solved = 0;
     for (int x0 = 0; x0 < w; x0 += kChunk) {
@@ -223,17 +228,36 @@ class RowPass {
       enter(x0, xe, t, L.inv_s2, ring, acc_, top, col_, s_.col_stride, prefix_, s_.prefix_stride,
             carry_);
       if (resum) {
-        resum_row(L.inv_s2 > 0.f, x0, xe, resum_rows, resum_count, acc_, top, ring, col_,
-                  s_.col_stride, solve ? prefix_ : nullptr, s_.prefix_stride, carry_);
+        resum_row(L.inv_s2 > 0.f, win_, x0, xe, resum_rows, resum_count, acc_, top, ring, col_,
+                  s_.col_stride, solve ? prefix_ : nullptr, s_.prefix_stride, carry_, L.lo);
       }
-      if (solve && x1 < w) {
+      if (solve && x1 < w && win_ == 0) {
         // A vector's solve reads prefix sums up to hi columns past its end.
         const int end = (x1 - L.hi) / N * N;
         solve_row(q, solved, end);
         if (end > solved) solved = end;
       }
     }
-    if (!solve) return;
+    if (solve) finish_row(q, half, solved);
+  }
+
+  // The solve of the row's last columns (all of them with the direct windows).
+  void finish_row(const SolveRow& q, bool half, int solved) {
+    const LevelJob& L = *L_;
+    constexpr int N = Native::N;
+    const int w = L.w;
+    if (win_ != 0) {
+      // (Every chunk is solved here: the windows lag the column sums by two vectors.)
+      const int xe = static_cast<int>(round_up(w, N));
+      if (win_ == 8) window_flush<8, kChannels>(xe, L.lo, carry_, prefix_, s_.prefix_stride);
+      if (win_ == 10) window_flush<10, kChannels>(xe, L.lo, carry_, prefix_, s_.prefix_stride);
+      solve_row(q, 0, w);
+      if (!flow_) {
+        q.un[w] = q.un[w - 1];
+        q.vn[w] = q.vn[w - 1];
+      }
+      return;
+    }
     // Windows end at the last column: past it the prefix sums stay at their last value and the
     // half-weight columns are zero, to the end of the last vector, so the padding lanes solve to
     // their old flow (finite, never denormal or NaN).
@@ -271,9 +295,10 @@ class RowPass {
   float* acc_ = nullptr;
   float* col_ = nullptr;
   float* prefix_ = nullptr;
-  alignas(64) float carry_[kChannels * 16] = {};
+  alignas(64) float carry_[kCarryVectors * 16] = {};
   int first_ = 0, next_ = 0;
   int solve_from_ = -(1 << 30);
+  int win_ = 0;  // the windows' width where the kernels make their sums directly, else 0
 };
 
 constexpr int kMaxIterations = 50;

@@ -10,6 +10,7 @@
 #pragma once
 
 #include "flow/lk_kernels.hpp"
+#include "flow/lk_window_impl.hpp"
 #include "flow/simd.hpp"
 
 namespace roiflow::flow::detail {
@@ -249,6 +250,8 @@ struct TermRows {
   const float *pa = nullptr, *pb = nullptr;
   const float *m0 = nullptr, *m1 = nullptr, *m2 = nullptr;
   const float *d1 = nullptr, *u1 = nullptr, *v1 = nullptr;
+  int w = 1 << 30;  // the row's width: the factors of the lanes from w on are zero
+  int lo = 0;       // the window's first column offset (windowed output only)
 };
 
 // The factors of row s's window terms at the vector of column x: Ix, Iy, r and, when robust,
@@ -348,11 +351,17 @@ ROIFLOW_INLINE void prefix_out(Native::F sum, Native::F bottom, Native::F top, i
   carry = S::add(S::last(scan), carry);
 }
 
+// The carried state of a row's horizontal sums: one vector per channel for the prefix sums,
+// three per channel for the windows (kWin 8 or 10).
+constexpr int kCarryVectors = 3 * kChannels;
+
 // Row s enters the window: its factors into the ring slot `ring` (which holds the leaving row's
 // when kLeaving) and its terms into the vertical sums; with kPrefix, the sums' horizontal prefix
 // sums (of the half-weight column sums when `top`, the window's first ring row, is given: `ring`
-// is then its last) into `prefix` (planar, `pstride` apart) and the column sums into `col`.
-template <int kDeriv, bool kRobust, bool kLeaving, bool kPrefix, bool kHalf>
+// is then its last) into `prefix` (planar, `pstride` apart) and the column sums into `col`; with
+// kWin, the windows kWin wide themselves (window_step: vector x's at x - 2N, the row's last two
+// by window_flush). The factors of the lanes from rows.w on are zero.
+template <int kDeriv, bool kRobust, bool kLeaving, bool kPrefix, bool kHalf, int kWin = 0>
 void enter_row_t(int x0, int x1, const TermRows& rows, float inv_s2_value, float* ring, float* acc,
                  const float* top, float* col, Idx col_stride, float* prefix, Idx pstride,
                  float* carry_mem) {
@@ -360,14 +369,19 @@ void enter_row_t(int x0, int x1, const TermRows& rows, float inv_s2_value, float
   using F = S::F;
   // Outside rows keep a zero weight too: a robust row leaving reads it.
   constexpr int kKept = kRobust || kDeriv == kOutside ? 4 : 3;
+  constexpr int kState = kWin ? 3 * kChannels : kChannels;
   const TermRows t = rows;  // a local: the stores below could alias `rows`
   const F inv_s2 = S::set1(inv_s2_value);
-  F carry[kChannels];
-  for (int c = 0; c < kChannels; ++c)
+  F carry[kState];
+  for (int c = 0; c < kState; ++c)
     carry[c] = S::load(carry_mem + c * S::N);
+  [[maybe_unused]] const WindowIndex<S> index(t.lo);
   for (int x = x0; x < x1; x += S::N) {
     F f[kFactors], term[kChannels], gone[kChannels], first[kChannels];
     factors<kDeriv, kRobust>(t, x, inv_s2, f);
+    if constexpr (kDeriv != kOutside) {
+      if (x + S::N > t.w) zero_lanes_from<S, kFactors>(f, t.w - x);
+    }
     terms<kRobust>(f, term);
     if constexpr (kLeaving) ring_terms<kRobust>(ring, x, gone);
     if constexpr (kHalf) ring_terms<kRobust>(top, x, first);
@@ -378,31 +392,36 @@ void enter_row_t(int x0, int x1, const TermRows& rows, float inv_s2_value, float
       const F old = S::load(ac);
       const F sum = kLeaving ? S::add(old, S::sub(term[c], gone[c])) : S::add(old, term[c]);
       S::store(ac, sum);
-      if constexpr (kPrefix) {
+      if constexpr (kPrefix && kWin != 0) {
+        S::store(prefix + c * pstride + x - 2 * S::N,
+                 window_step<S, kWin>(sum, carry + 3 * c, index));
+      } else if constexpr (kPrefix) {
         prefix_out<kHalf>(sum, term[c], first[c], x, c, col, col_stride, prefix, pstride, carry[c]);
       }
     }
   }
-  for (int c = 0; c < kChannels; ++c)
+  for (int c = 0; c < kState; ++c)
     S::store(carry_mem + c * S::N, carry[c]);
 }
 
 // Fresh window sums: acc = the terms of the window's ring rows added top to bottom (then their
-// prefix sums as in enter_row, unless `prefix` is null). A running sum's rounding depends on
-// where it started: summing afresh every `stripe` rows makes every row independent of where its
-// pass began.
-template <bool kRobust>
+// prefix sums as in enter_row, or with kWin their windows, unless `prefix` is null). A running
+// sum's rounding depends on where it started: summing afresh every `stripe` rows makes every
+// row independent of where its pass began.
+template <bool kRobust, int kWin>
 void resum_row_t(int x0, int x1, const float* const* row_list, int count, float* acc,
                  const float* top, const float* bot, float* col, Idx col_stride, float* prefix,
-                 Idx pstride, float* carry_mem) {
+                 Idx pstride, float* carry_mem, int lo) {
   const float* rows[64];
   for (int r = 0; r < count; ++r)
     rows[r] = row_list[r];
   using S = Native;
   using F = S::F;
-  F carry[kChannels];
-  for (int c = 0; c < kChannels; ++c)
+  constexpr int kState = kWin ? 3 * kChannels : kChannels;
+  F carry[kState];
+  for (int c = 0; c < kState; ++c)
     carry[c] = S::load(carry_mem + c * S::N);
+  [[maybe_unused]] const WindowIndex<S> index(lo);
   for (int x = x0; x < x1; x += S::N) {
     F sum[kChannels], term[kChannels];
     ring_terms<kRobust>(rows[0], x, sum);
@@ -414,7 +433,12 @@ void resum_row_t(int x0, int x1, const float* const* row_list, int count, float*
     for (int c = 0; c < kChannels; ++c)
       S::store(at(acc, x, c), sum[c]);
     if (!prefix) continue;
-    if (top) {
+    if constexpr (kWin != 0) {
+      for (int c = 0; c < kChannels; ++c) {
+        S::store(prefix + c * pstride + x - 2 * S::N,
+                 window_step<S, kWin>(sum[c], carry + 3 * c, index));
+      }
+    } else if (top) {
       F first[kChannels], last[kChannels];
       ring_terms<kRobust>(top, x, first);
       ring_terms<kRobust>(bot, x, last);
@@ -427,19 +451,38 @@ void resum_row_t(int x0, int x1, const float* const* row_list, int count, float*
         prefix_out<false>(sum[c], sum[c], sum[c], x, c, col, col_stride, prefix, pstride, carry[c]);
     }
   }
-  for (int c = 0; c < kChannels; ++c)
+  for (int c = 0; c < kState; ++c)
     S::store(carry_mem + c * S::N, carry[c]);
 }
 
-void resum_row(bool robust, int x0, int x1, const float* const* row_list, int count, float* acc,
-               const float* top, const float* bot, float* col, Idx col_stride, float* prefix,
-               Idx pstride, float* carry_mem) {
-  if (robust) {
-    return resum_row_t<true>(x0, x1, row_list, count, acc, top, bot, col, col_stride, prefix,
-                             pstride, carry_mem);
+template <bool kRobust>
+void resum_row_w(int win, int x0, int x1, const float* const* row_list, int count, float* acc,
+                 const float* top, const float* bot, float* col, Idx col_stride, float* prefix,
+                 Idx pstride, float* carry_mem, int lo) {
+  if constexpr (Native::kPermute2) {
+    if (win == 8) {
+      return resum_row_t<kRobust, 8>(x0, x1, row_list, count, acc, top, bot, col, col_stride,
+                                     prefix, pstride, carry_mem, lo);
+    }
+    if (win == 10) {
+      return resum_row_t<kRobust, 10>(x0, x1, row_list, count, acc, top, bot, col, col_stride,
+                                      prefix, pstride, carry_mem, lo);
+    }
   }
-  resum_row_t<false>(x0, x1, row_list, count, acc, top, bot, col, col_stride, prefix, pstride,
-                     carry_mem);
+  resum_row_t<kRobust, 0>(x0, x1, row_list, count, acc, top, bot, col, col_stride, prefix, pstride,
+                          carry_mem, lo);
+}
+
+// `win`: 0 for prefix sums, else the width of the windows made (window_width).
+void resum_row(bool robust, int win, int x0, int x1, const float* const* row_list, int count,
+               float* acc, const float* top, const float* bot, float* col, Idx col_stride,
+               float* prefix, Idx pstride, float* carry_mem, int lo) {
+  if (robust) {
+    return resum_row_w<true>(win, x0, x1, row_list, count, acc, top, bot, col, col_stride, prefix,
+                             pstride, carry_mem, lo);
+  }
+  resum_row_w<false>(win, x0, x1, row_list, count, acc, top, bot, col, col_stride, prefix, pstride,
+                     carry_mem, lo);
 }
 
 struct SolveRow {
@@ -453,7 +496,8 @@ struct SolveRow {
   float inv_cy, lambda;
   const float *uo, *vo;
   float *un, *vn, *conf;
-  float* flow;  // non-null: (u, v) interleaved here instead of un, vn (rows not padded)
+  float* flow;    // non-null: (u, v) interleaved here instead of un, vn (rows not padded)
+  bool windowed;  // prefix holds the window sums themselves (window_row), aligned with x
 };
 
 // The window sum p[x + hi] - p[x + lo - 1] from the prefix sums' aligned vectors at x - N
@@ -469,7 +513,7 @@ ROIFLOW_INLINE typename S::F window_sum(typename S::F before, typename S::F here
   }
 }
 
-template <bool kHalf, bool kConfidence, bool kInterleaved>
+template <bool kHalf, bool kConfidence, bool kInterleaved, bool kWindowed = false>
 void solve_row_t(const SolveRow& q, int x0, int x1) {
   using S = Native;
   using F = S::F;
@@ -493,7 +537,7 @@ void solve_row_t(const SolveRow& q, int x0, int x1) {
   // come from the aligned vectors at x - N, x and x + N, kept in registers from one vector to
   // the next and permuted: the same floats as the loads N floats long at those columns, each of
   // which would span two cache lines.
-  constexpr bool kAligned = S::kPermute2 && !kHalf;
+  constexpr bool kAligned = S::kPermute2 && !kHalf && !kWindowed;
   [[maybe_unused]] F before[kChannels], here[kChannels];
   [[maybe_unused]] S::I at_hi, at_lo;
   const bool aligned = kAligned && hi >= 0 && hi < S::N && lo <= 0 && lo > -S::N;
@@ -511,6 +555,10 @@ void solve_row_t(const SolveRow& q, int x0, int x1) {
   for (int x = x0; x < x1; x += S::N) {
     F s[kChannels];
     for (int c = 0; c < kChannels; ++c) {
+      if constexpr (kWindowed) {
+        s[c] = S::load(p[c] - hi + x);
+        continue;
+      }
       if constexpr (kAligned) {
         if (aligned) {
           const F after = S::load(p[c] - hi + x + S::N);
@@ -568,6 +616,16 @@ void solve_row_t(const SolveRow& q, int x0, int x1) {
 
 template <bool kHalf>
 void solve_row_h(const SolveRow& q, int x0, int x1) {
+  if constexpr (!kHalf && Native::kPermute2) {
+    if (q.windowed) {
+      if (q.flow) {
+        if (q.conf) return solve_row_t<false, true, true, true>(q, x0, x1);
+        return solve_row_t<false, false, true, true>(q, x0, x1);
+      }
+      if (q.conf) return solve_row_t<false, true, false, true>(q, x0, x1);
+      return solve_row_t<false, false, false, true>(q, x0, x1);
+    }
+  }
   if (q.flow) {
     if (q.conf) return solve_row_t<kHalf, true, true>(q, x0, x1);
     return solve_row_t<kHalf, false, true>(q, x0, x1);
@@ -586,32 +644,38 @@ using EnterFn = void (*)(int, int, const TermRows&, float, float*, float*, const
                          Idx, float*, Idx, float*);
 
 template <int kDeriv, bool kRobust, bool kLeaving>
-EnterFn pick_enter_output(bool prefix, bool half) {
+EnterFn pick_enter_output(bool prefix, bool half, int win) {
   if (!prefix) return enter_row_t<kDeriv, kRobust, kLeaving, false, false>;
+  if constexpr (Native::kPermute2) {
+    if (win == 8) return enter_row_t<kDeriv, kRobust, kLeaving, true, false, 8>;
+    if (win == 10) return enter_row_t<kDeriv, kRobust, kLeaving, true, false, 10>;
+  }
   return half ? enter_row_t<kDeriv, kRobust, kLeaving, true, true>
               : enter_row_t<kDeriv, kRobust, kLeaving, true, false>;
 }
 
 template <int kDeriv, bool kRobust>
-EnterFn pick_enter_flags(bool leaving, bool prefix, bool half) {
-  return leaving ? pick_enter_output<kDeriv, kRobust, true>(prefix, half)
-                 : pick_enter_output<kDeriv, kRobust, false>(prefix, half);
+EnterFn pick_enter_flags(bool leaving, bool prefix, bool half, int win) {
+  return leaving ? pick_enter_output<kDeriv, kRobust, true>(prefix, half, win)
+                 : pick_enter_output<kDeriv, kRobust, false>(prefix, half, win);
 }
 
-EnterFn pick_enter(int deriv, bool robust, bool leaving, bool prefix, bool half) {
+// With `win` (window_width's, not 0: two-vector permutes, no half weights), the output is the
+// windows' sums instead of the prefix sums.
+EnterFn pick_enter(int deriv, bool robust, bool leaving, bool prefix, bool half, int win) {
   switch (deriv) {
     case kHornSchunck:
-      return robust ? pick_enter_flags<kHornSchunck, true>(leaving, prefix, half)
-                    : pick_enter_flags<kHornSchunck, false>(leaving, prefix, half);
+      return robust ? pick_enter_flags<kHornSchunck, true>(leaving, prefix, half, win)
+                    : pick_enter_flags<kHornSchunck, false>(leaving, prefix, half, win);
     case kScharr:
-      return robust ? pick_enter_flags<kScharr, true>(leaving, prefix, half)
-                    : pick_enter_flags<kScharr, false>(leaving, prefix, half);
+      return robust ? pick_enter_flags<kScharr, true>(leaving, prefix, half, win)
+                    : pick_enter_flags<kScharr, false>(leaving, prefix, half, win);
     case kCentral:
-      return robust ? pick_enter_flags<kCentral, true>(leaving, prefix, half)
-                    : pick_enter_flags<kCentral, false>(leaving, prefix, half);
+      return robust ? pick_enter_flags<kCentral, true>(leaving, prefix, half, win)
+                    : pick_enter_flags<kCentral, false>(leaving, prefix, half, win);
     default:  // (the leaving row's terms are recomputed with its weight when robust)
-      return robust ? pick_enter_flags<kOutside, true>(leaving, prefix, half)
-                    : pick_enter_flags<kOutside, false>(leaving, prefix, half);
+      return robust ? pick_enter_flags<kOutside, true>(leaving, prefix, half, win)
+                    : pick_enter_flags<kOutside, false>(leaving, prefix, half, win);
   }
 }
 
