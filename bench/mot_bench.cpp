@@ -6,7 +6,7 @@
 //                                     decoding excluded); counters: fps (frames per second of
 //                                     wall time), mota and idf1 of that run against the scene's
 //                                     boxes. N in {1, 4, 16, 64}, 640x480 and 1280x720, 1 and 2
-//                                     threads (and 4 where the machine has them).
+//                                     threads (and 4, 8, 16 where the machine has them).
 //   BM_TrafficRender/<N>/<W>x<H>      rendering one frame of the scene with N vehicles (the
 //                                     cost a synthetic:...:N input adds to the source stage)
 //
@@ -118,7 +118,7 @@ const int kRegistered = [] {
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   for (const cv::Size size : {cv::Size(640, 480), cv::Size(1280, 720)}) {
     for (const int n : {1, 4, 16, 64}) {
-      for (const int t : {1, 2, 4}) {
+      for (const int t : {1, 2, 4, 8, 16}) {
         if (t > 2 && t > cores) continue;
         const std::string name = "BM_TrackObjects/" + std::to_string(n) + "/" +
                                  std::to_string(size.width) + "x" + std::to_string(size.height) +
