@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/video/background_segm.hpp>
 #include <set>
 #include <sstream>
 
@@ -124,6 +125,39 @@ TEST(DetectObjects, AHoleInsideAnObjectIsNoValley) {
   EXPECT_EQ(found[0].box, cv::Rect2f(20, 30, 70, 30));
 }
 
+TEST(MotionDetector, BandsOfRowsMaskAsOneModelOverTheFrame) {
+  // The model learns in bands of rows (in parallel); MOG2 models each pixel alone, so the mask
+  // is the one a single model over the whole frame gives, at any thread count. The comparison
+  // needs the detector's own steps off (ghosts, scene start, opening) and the frame at its
+  // working size.
+  MotScene scene({320, 240}, {{{-40, 40, 20, 50}, {3, 0}, 40}, {{230, 130, 30, 30}, {-2, 1}, 40}});
+  tracking::MotionDetectorParams p;
+  p.ghost_frames = 0;
+  p.start_frames = 0;
+  p.open = 0;
+  p.work_width = 320;
+  const int previous = cv::getNumThreads();
+  for (const int threads : {1, 4}) {
+    cv::setNumThreads(threads);
+    tracking::MotionDetector detector(p);
+    cv::Ptr<cv::BackgroundSubtractorMOG2> one =
+        cv::createBackgroundSubtractorMOG2(p.history, p.var_threshold, p.shadows);
+    one->setShadowThreshold(p.shadow_threshold);
+    one->setBackgroundRatio(p.background_ratio);
+    int moving = 0;
+    for (int t = 0; t < 60; ++t) {  // the objects enter at frame 40
+      const cv::Mat frame = scene.frame(t);
+      const tracking::Foreground fg = detector.observe(frame);
+      cv::Mat raw, mask;
+      one->apply(frame, raw);
+      cv::threshold(raw, mask, 200, 255, cv::THRESH_BINARY);
+      ASSERT_EQ(cv::countNonZero(fg.mask != mask), 0) << "frame " << t << ", threads " << threads;
+      moving += cv::countNonZero(mask);
+    }
+    EXPECT_GT(moving, 1000);  // the comparison saw moving pixels
+  }
+  cv::setNumThreads(previous);
+}
 // Object 0 stands still from the first frame, so that the background model learns it as
 // background; at frame 30 object 1 takes its place and drives away. Where object 0 stood then
 // turns into foreground for a while (a ghost), though nothing changes there.
