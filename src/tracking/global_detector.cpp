@@ -4,11 +4,12 @@
 #include <array>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/video/background_segm.hpp>
+#include <optional>
 #include <string>
 
 #include "core/error.hpp"
 #include "core/text.hpp"
+#include "tracking/banded_mog2.hpp"
 #include "tracking/template_search.hpp"
 
 namespace roiflow::tracking {
@@ -147,8 +148,8 @@ void GlobalDetectorParams::validate() const {
 
 struct GlobalDetector::Impl {
   GlobalDetectorParams params;
-  cv::Ptr<cv::BackgroundSubtractorMOG2> model;
-  cv::Size frame_size;  // of the first observed frame
+  std::optional<BandedMog2> model;  // learns in bands of rows, in parallel
+  cv::Size frame_size;              // of the first observed frame
   cv::Size work_size;
   cv::Point2d to_full{1, 1};  // full-resolution pixels per model pixel, in x and y
   long long observed = 0;
@@ -310,7 +311,10 @@ GlobalDetector::GlobalDetector(const GlobalDetectorParams& params)
   s.params = params;
   // Shadows are not detected: a shadow is not the object, and labelling them
   // costs time.
-  s.model = cv::createBackgroundSubtractorMOG2(params.history, 16.0, false);
+  BandedMog2Params model_params;
+  model_params.history = params.history;
+  model_params.shadows = false;
+  s.model.emplace(model_params);
   s.open_kernel = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(3, 3));
   s.close_kernel = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(7, 7));
 }

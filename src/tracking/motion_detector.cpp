@@ -11,6 +11,7 @@
 
 #include "core/error.hpp"
 #include "core/text.hpp"
+#include "tracking/banded_mog2.hpp"
 #include "tracking/start_motion_impl.hpp"
 
 namespace roiflow::tracking {
@@ -99,11 +100,12 @@ constexpr int kReach = 11;
 }  // namespace
 
 struct MotionDetector::Impl {
-  // MOG2 models each pixel alone, so the frame is cut into bands of rows, each with a model of
-  // its own, that learn in parallel (cv::parallel_for_: the caller's threads): the same masks as
-  // one model over the whole frame, which OpenCV would run on one thread below 65536 pixels.
-  std::vector<cv::Ptr<cv::BackgroundSubtractorMOG2>> models;
-  std::vector<cv::Range> bands;
+  // Shadows are labelled (127) and then count as background: a pedestrian's or a car's shadow
+  // is not the object, and would merge neighbours into one blob.
+  explicit Impl(const MotionDetectorParams& p)
+      : model(BandedMog2Params{p.history, p.var_threshold, p.shadows, p.shadow_threshold,
+                               p.background_ratio}) {}
+  BandedMog2 model;
   cv::Size frame_size;
   int scale = 1;
   cv::Mat small, raw;
@@ -329,27 +331,9 @@ long long absorb_ghosts(cv::Mat& mask, const cv::Mat& gray, const cv::Mat& old,
 }  // namespace
 
 MotionDetector::MotionDetector(const MotionDetectorParams& params)
-    : params_(params), impl_(std::make_shared<Impl>()) {
+    : params_(params), impl_(std::make_shared<Impl>(params)) {
   params_.validate();
-  // Shadows are labelled (127) and then count as background: a pedestrian's or a car's shadow
-  // is not the object, and would merge neighbours into one blob.
 }
-
-namespace {
-
-// Bands of at least kBandRows rows (the last takes the rest), at most kMaxBands.
-constexpr int kBandRows = 32;
-constexpr int kMaxBands = 16;
-
-std::vector<cv::Range> model_bands(int rows) {
-  const int count = std::clamp(rows / kBandRows, 1, kMaxBands);
-  std::vector<cv::Range> bands;
-  for (int i = 0; i < count; ++i)
-    bands.emplace_back(rows * i / count, rows * (i + 1) / count);
-  return bands;
-}
-
-}  // namespace
 
 bool wants_flow(const MotionDetectorParams& params, long long index) {
   return params.start_motion > 0 && index >= 1 && index <= params.start_frames;
@@ -382,22 +366,7 @@ Foreground MotionDetector::observe(const cv::Mat& image, const flow::FlowResult*
                cv::INTER_AREA);
     input = &s.small;
   }
-  if (s.models.empty()) {
-    s.bands = model_bands(input->rows);
-    for (std::size_t i = 0; i < s.bands.size(); ++i) {
-      s.models.push_back(cv::createBackgroundSubtractorMOG2(params_.history, params_.var_threshold,
-                                                            params_.shadows));
-      s.models.back()->setShadowThreshold(params_.shadow_threshold);
-      s.models.back()->setBackgroundRatio(params_.background_ratio);
-    }
-  }
-  s.raw.create(input->size(), CV_8U);
-  cv::parallel_for_(cv::Range(0, static_cast<int>(s.bands.size())), [&](const cv::Range& r) {
-    for (int i = r.start; i < r.end; ++i) {
-      cv::Mat out = s.raw.rowRange(s.bands[i]);
-      s.models[i]->apply(input->rowRange(s.bands[i]), out);
-    }
-  });
+  s.model.apply(*input, s.raw);
   ++s.observed;
   Foreground fg;
   fg.observed = s.observed;

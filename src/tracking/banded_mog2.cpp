@@ -1,0 +1,42 @@
+#include "tracking/banded_mog2.hpp"
+
+#include <algorithm>
+#include <string>
+
+#include "core/error.hpp"
+
+namespace roiflow::tracking {
+
+namespace {
+
+// Bands of at least kBandRows rows (each takes its share of the rest), at most kMaxBands.
+constexpr int kBandRows = 32;
+constexpr int kMaxBands = 16;
+
+}  // namespace
+
+void BandedMog2::apply(const cv::Mat& image, cv::Mat& mask, double learning_rate) {
+  if (models_.empty()) {
+    const int count = std::clamp(image.rows / kBandRows, 1, kMaxBands);
+    for (int i = 0; i < count; ++i) {
+      bands_.emplace_back(image.rows * i / count, image.rows * (i + 1) / count);
+      models_.push_back(cv::createBackgroundSubtractorMOG2(params_.history, params_.var_threshold,
+                                                           params_.shadows));
+      if (params_.shadow_threshold) models_.back()->setShadowThreshold(*params_.shadow_threshold);
+      if (params_.background_ratio) models_.back()->setBackgroundRatio(*params_.background_ratio);
+    }
+  } else if (image.rows != bands_.back().end) {
+    throw Error("background model: frame of " + std::to_string(image.rows) +
+                " rows after frames of " + std::to_string(bands_.back().end));
+  }
+  mask.create(image.size(), CV_8U);
+  cv::parallel_for_(cv::Range(0, static_cast<int>(models_.size())), [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i) {
+      cv::Mat band = mask.rowRange(bands_[static_cast<std::size_t>(i)]);
+      models_[static_cast<std::size_t>(i)]->apply(
+          image.rowRange(bands_[static_cast<std::size_t>(i)]), band, learning_rate);
+    }
+  });
+}
+
+}  // namespace roiflow::tracking

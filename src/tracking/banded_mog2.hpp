@@ -1,0 +1,43 @@
+// OpenCV's MOG2 background model (cv::BackgroundSubtractorMOG2) learning in bands of rows: each
+// band of at least 32 rows has a model of its own, and the bands learn in parallel on the
+// caller's threads (cv::parallel_for_, which runs in the oneTBB arena of the graph that calls
+// it). MOG2 models each pixel alone, so the mask is the one a single model over the whole frame
+// gives, at any thread count; OpenCV itself runs a frame under 65536 pixels (the tracker's
+// working size) on one thread, which made the background refresh the serial bound of tracking
+// on many cores.
+//
+//   roiflow::tracking::BandedMog2Params params;  // history 500, variance threshold 16, shadows
+//   roiflow::tracking::BandedMog2 model(params);
+//   cv::Mat mask;  // CV_8U: 255 foreground, 127 shadow, 0 background
+//   model.apply(frame_t, mask);         // MOG2's own learning rate
+//   model.apply(frame_t1, mask, 0.01);  // or a given one
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <opencv2/video/background_segm.hpp>
+#include <optional>
+#include <vector>
+
+namespace roiflow::tracking {
+
+struct BandedMog2Params {
+  int history = 500;                       // MOG2 history, frames
+  double var_threshold = 16;               // MOG2 variance threshold
+  bool shadows = true;                     // label shadows (127)
+  std::optional<double> shadow_threshold;  // unset: OpenCV's default
+  std::optional<double> background_ratio;  // unset: OpenCV's default
+};
+
+class BandedMog2 {
+ public:
+  explicit BandedMog2(const BandedMog2Params& params) : params_(params) {}
+  // The frame's mask (CV_8U, frame-sized); the first frame sets the size the model keeps.
+  void apply(const cv::Mat& image, cv::Mat& mask, double learning_rate = -1);
+
+ private:
+  BandedMog2Params params_;
+  std::vector<cv::Ptr<cv::BackgroundSubtractorMOG2>> models_;
+  std::vector<cv::Range> bands_;
+};
+
+}  // namespace roiflow::tracking
