@@ -467,9 +467,11 @@ namespace {
 // frame wants it.
 class StartFlowNode {
  public:
-  StartFlowNode(tf::graph& g, Run& run, const tracking::MultiTrackerParams& params)
+  // `stripes` runs each frame's LK in row stripes (the result is the same at any thread count).
+  StartFlowNode(tf::graph& g, Run& run, const tracking::MultiTrackerParams& params,
+                const Executor* stripes)
       : params_(params),
-        lk_(params.lk),
+        lk_(params.lk, stripes),
         node_(g, tf::serial, [this, &run](const FrameMsg& m) { return step(run, m); }) {}
   tf::function_node<FrameMsg, StartMsg>& node() { return node_; }
 
@@ -502,9 +504,10 @@ class StartFlowNode {
 class SplitNode {
  public:
   using Met = std::tuple<SeenMsg, DecidedMsg>;
-  SplitNode(tf::graph& g, Run& run, const tracking::MultiTrackerParams& params)
+  SplitNode(tf::graph& g, Run& run, const tracking::MultiTrackerParams& params,
+            const Executor* stripes)
       : params_(params),
-        lk_(params.lk),
+        lk_(params.lk, stripes),
         node_(g, tf::serial, [this, &run](Met in) { return step(run, std::move(in)); }) {}
   tf::function_node<Met, Met>& node() { return node_; }
 
@@ -543,7 +546,9 @@ RunReport run_mot(const FrameSource& source, const tracking::MultiTrackerParams&
     tf::graph g;
     FrontEnd front(g, run, source, limit, params.lk.levels, params.lk.sigma);
 
-    StartFlowNode start_flow(g, run, params);  // the scene start's flow, then
+    // Whole-frame and whole-box LK in serial nodes runs in row stripes on the arena's threads.
+    const TbbExecutor stripes;
+    StartFlowNode start_flow(g, run, params, &stripes);  // the scene start's flow, then
     // background refresh: serial, in frame order (the model learns the frames in order).
     tracking::MotionDetector detector(params.detector);
     tf::function_node<StartMsg, SeenMsg> background(g, tf::serial, [&](const StartMsg& m) {
@@ -567,7 +572,7 @@ RunReport run_mot(const FrameSource& source, const tracking::MultiTrackerParams&
         g, [](const SeenMsg& m) { return static_cast<std::size_t>(m.seq); });
     // Frame t+1 meets the decisions at t (the feedback edge), then the motion split.
     tf::join_node<std::tuple<SeenMsg, DecidedMsg>, tf::queueing> meet(g);
-    SplitNode split(g, run, params);
+    SplitNode split(g, run, params, &stripes);
     using PlanNode =
         tf::multifunction_node<std::tuple<SeenMsg, DecidedMsg>, std::tuple<TileMsg, CollectMsg>>;
     PlanNode plan(g, tf::serial, [&](const std::tuple<SeenMsg, DecidedMsg>& in, auto& ports) {
