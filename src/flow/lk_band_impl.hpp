@@ -132,14 +132,23 @@ class RowPass {
     }
   }
 
+  // Warped row r whole, and its Horn–Schunck pairs.
+  void warp_whole(int r, int slot) {
+    const int xe = static_cast<int>(round_up(L_->w, Native::N));
+    if (L_->derivative == kHornSchunck) {
+      return warp_pairs_row(*L_, L_->y0 + r, row_u(in_, r), row_v(in_, r), m_[slot], d_[slot],
+                            pairs_[slot], xe);
+    }
+    warp_chunk(r, slot, 0, L_->w);
+  }
+
   // Warped row r of the rectangle (clamped to it), whole, from the cache of the last four.
   int warped(int r) {
     r = imin(imax(r, 0), L_->h - 1);
     const int slot = r & 3;
     if (cache_row_[slot] != r) {
       cache_row_[slot] = r;
-      warp_chunk(r, slot, 0, L_->w);
-      pairs_chunk(r, slot, 0, static_cast<int>(round_up(L_->w, Native::N)));
+      warp_whole(r, slot);
     }
     return slot;
   }
@@ -215,12 +224,20 @@ class RowPass {
     }
     for (int c = 0; c < (win_ != 0 ? kCarryVectors : kChannels); ++c)
       Native::store(carry_ + c * N, Native::set1(0.f));
-    if (fresh >= 0) warp_chunk(fresh, fresh_slot, 0, imin(kChunk, w));
+    // (A row of one chunk is warped with its pairs at once.)
+    const bool whole = w <= kChunk;
+    if (fresh >= 0) {
+      if (whole) {
+        warp_whole(fresh, fresh_slot);
+      } else {
+        warp_chunk(fresh, fresh_slot, 0, kChunk);
+      }
+    }
     int solved = 0;
     for (int x0 = 0; x0 < w; x0 += kChunk) {
       const int x1 = imin(x0 + kChunk, w);
       const int xe = x1 == w ? static_cast<int>(round_up(w, N)) : x1;
-      if (fresh >= 0) {
+      if (fresh >= 0 && !whole) {
         // The pairs of x1 - 1 read column x1: the warp runs a chunk ahead.
         if (x1 < w) warp_chunk(fresh, fresh_slot, x1, imin(x1 + kChunk, w));
         pairs_chunk(fresh, fresh_slot, x0, xe);

@@ -100,10 +100,11 @@ ROIFLOW_INLINE bool near_taps(const WarpGeometry& g, typename S::I ix, typename 
   }
 }
 
+// The warp of one vector (or one pixel): its m and d.
 template <class S>
-ROIFLOW_INLINE void warp_block(const WarpGeometry& g, float fx0, float fy, const float* u,
-                               const float* v, const float* i0, float* m, float* d,
-                               bool may_load_rows) {
+ROIFLOW_INLINE void warp_values(const WarpGeometry& g, float fx0, float fy, const float* u,
+                                const float* v, const float* i0, bool may_load_rows,
+                                typename S::F& m, typename S::F& d) {
   using F = typename S::F;
   using I = typename S::I;
   const F zero = S::set1(0.f);
@@ -134,15 +135,21 @@ ROIFLOW_INLINE void warp_block(const WarpGeometry& g, float fx0, float fy, const
   const F bot = S::madd(fx, S::sub(p11, p10), p10);
   const F w1 = S::madd(fyv, S::sub(bot, top), top);
   const F a = S::load(i0);
-  S::store(m, S::mul(S::set1(0.5f), S::add(a, w1)));
-  S::store(d, S::sub(w1, a));
+  m = S::mul(S::set1(0.5f), S::add(a, w1));
+  d = S::sub(w1, a);
 }
 
-// Row y of the level (global), columns [x0, x1) of the rectangle (x1 <= w) into m, d (indexed
-// from the rectangle's column 0), and the replicated columns m[-1] (with column 0) and m[w]
-// (with column w - 1), d likewise.
-void warp_row(const LevelJob& L, int y, const float* u, const float* v, float* m, float* d, int x0,
-              int x1) {
+template <class S>
+ROIFLOW_INLINE void warp_block(const WarpGeometry& g, float fx0, float fy, const float* u,
+                               const float* v, const float* i0, float* m, float* d,
+                               bool may_load_rows) {
+  typename S::F mv, dv;
+  warp_values<S>(g, fx0, fy, u, v, i0, may_load_rows, mv, dv);
+  S::store(m, mv);
+  S::store(d, dv);
+}
+
+WarpGeometry warp_geometry(const LevelJob& L) {
   WarpGeometry g;
   g.base = L.i1;
   g.step = L.i1_step;
@@ -152,6 +159,15 @@ void warp_row(const LevelJob& L, int y, const float* u, const float* v, float* m
   g.iymax = imax(0, L.rows - 2);
   g.dx1 = L.cols > 1 ? 1 : 0;
   g.dy1 = L.rows > 1 ? static_cast<int>(L.i1_step) : 0;
+  return g;
+}
+
+// Row y of the level (global), columns [x0, x1) of the rectangle (x1 <= w) into m, d (indexed
+// from the rectangle's column 0), and the replicated columns m[-1] (with column 0) and m[w]
+// (with column w - 1), d likewise.
+void warp_row(const LevelJob& L, int y, const float* u, const float* v, float* m, float* d, int x0,
+              int x1) {
+  const WarpGeometry g = warp_geometry(L);
   const bool rows_ok = L.cols > 1 && L.rows > 1;
   const float* i0 = L.i0 + static_cast<Idx>(y) * L.i0_step + L.x0;
   const float fy = static_cast<float>(y);
@@ -241,6 +257,57 @@ void hs_pairs(int x0, int x1, const float* m, const float* d, const float* u, co
     u0 = u2;
     v0 = v2;
   }
+}
+
+// Warped row y whole and its Horn–Schunck pairs up to the vector end xe: warp_row(L, y, u, v, m,
+// d, 0, L.w) then hs_pairs(0, xe, ...), the same floats, but each vector's pairs are made from the
+// warp's registers as the next vector is warped (its m and d are neither stored nor loaded back;
+// a load of m one vector on would wait for the store just made). The last vectors go through
+// memory as before. m and d of the bulk are not stored: only the Horn–Schunck pairs read them.
+void warp_pairs_row(const LevelJob& L, int y, const float* u, const float* v, float* m, float* d,
+                    float* pairs, int xe) {
+  using S = Native;
+  using F = S::F;
+  constexpr int N = S::N;
+  const int w = L.w;
+  if (L.mask_outside || L.cols < 2 || L.rows < 2 || w < 2 * N) {
+    warp_row(L, y, u, v, m, d, 0, w);
+    return hs_pairs(0, xe, m, d, u, v, pairs);
+  }
+  const WarpGeometry g = warp_geometry(L);
+  const float* i0 = L.i0 + static_cast<Idx>(y) * L.i0_step + L.x0;
+  const float fy = static_cast<float>(y);
+  F m0, d0;
+  warp_values<S>(g, static_cast<float>(L.x0), fy, u, v, i0, true, m0, d0);
+  F u0 = S::load(u), v0 = S::load(v);
+  int x = N;
+  for (; x + N <= w; x += N) {
+    F m2, d2;
+    warp_values<S>(g, static_cast<float>(L.x0 + x), fy, u + x, v + x, i0 + x, true, m2, d2);
+    const F u2 = S::load(u + x), v2 = S::load(v + x);
+    const F m1 = S::next1(m0, m2);
+    const int p = x - N;
+    S::store(at(pairs, p, 0), S::sub(m1, m0));
+    S::store(at(pairs, p, 1), S::add(m0, m1));
+    S::store(at(pairs, p, 2), S::add(d0, S::next1(d0, d2)));
+    S::store(at(pairs, p, 3), S::add(u0, S::next1(u0, u2)));
+    S::store(at(pairs, p, 4), S::add(v0, S::next1(v0, v2)));
+    m0 = m2;
+    d0 = d2;
+    u0 = u2;
+    v0 = v2;
+  }
+  // The last whole vector (at x - N), the columns after it and the replicated column w through
+  // memory, as warp_row leaves them; their pairs as hs_pairs makes them.
+  S::store(m + x - N, m0);
+  S::store(d + x - N, d0);
+  for (int c = x; c < w; ++c) {
+    warp_block<Scalar>(g, static_cast<float>(L.x0 + c), fy, u + c, v + c, i0 + c, m + c, d + c,
+                       false);
+  }
+  m[w] = m[w - 1];
+  d[w] = d[w - 1];
+  hs_pairs(x - N, xe, m, d, u, v, pairs);
 }
 
 // The rows the entering derivative-grid row s is made of. Horn–Schunck: the pairs of warped rows
