@@ -428,8 +428,17 @@ void run_band(const BandJob& job) {
 }  // namespace
 
 extern const LkKernels ROIFLOW_KERNEL_TABLE;
-const LkKernels ROIFLOW_KERNEL_TABLE = {simd::kNativeName, Native::N, scratch_floats, run_band,
-                                        input_rows,        band_rows, upsample_row,   unit_row_u8,
-                                        smooth_h,          smooth_v};
+const LkKernels ROIFLOW_KERNEL_TABLE = {simd::kNativeName,
+                                        Native::N,
+                                        scratch_floats,
+                                        run_band,
+                                        input_rows,
+                                        band_rows,
+                                        upsample_row,
+                                        unit_row_u8,
+                                        smooth_h,
+                                        smooth_v,
+                                        Native::kPermute2 ? pyr_down_h : nullptr,
+                                        Native::kPermute2 ? pyr_down_v : nullptr};
 
 }  // namespace roiflow::flow::detail

@@ -121,6 +121,11 @@ struct LkKernels {
   // each side, and of the 2 radius + 1 rows `rows` at each column.
   void (*smooth_h)(const float* padded, const float* k, int radius, int w, float* out);
   void (*smooth_v)(const float* const* rows, const float* k, int radius, int w, float* out);
+  // cv::pyrDown of float images, bit for bit, in two row steps (null without two-vector
+  // permutes: OpenCV's own is used there): a row of w >= 8 columns filtered and halved into
+  // (w + 1) / 2, and the output row from the five halved rows 2y - 2 .. 2y + 2 (reflected).
+  void (*pyr_down_h)(const float* src, int w, float* row);
+  void (*pyr_down_v)(const float* const* rows, int dw, float* dst);
 };
 
 // Floats of LkKernels::upsample_row's temporary for n coarse pixels.

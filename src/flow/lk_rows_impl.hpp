@@ -158,5 +158,96 @@ void smooth_v(const float* const* rows, const float* k, int radius, int w, float
   }
 }
 
+// cv::pyrDown of float images, bit for bit, as OpenCV's 128-bit SIMD build computes it: [1 4 6 4 1]
+// on every second column of a row, then on every second row, x 1/256, borders reflected (101).
+// OpenCV's vector loops (4 lanes) and its scalar code sum in different orders; which columns
+// each takes is reproduced (tested against cv::pyrDown on frames of many sizes). Used with
+// two-vector permutes only (the even and odd columns of two vectors).
+
+// The scalar order: src[2x] * 6 + (src[2x - 1] + src[2x + 1]) * 4 + src[2x - 2] + src[2x + 2].
+ROIFLOW_INLINE float down_scalar(float r0, float r1, float r2, float r3, float r4) {
+  return r2 * 6.f + (r1 + r3) * 4.f + r0 + r4;
+}
+// The vector order: r2 * 6 + ((r1 + r3) * 4 + (r0 + r4)), no fused multiply-add.
+template <class S>
+ROIFLOW_INLINE typename S::F down_h_vector(typename S::F r0, typename S::F r1, typename S::F r2,
+                                           typename S::F r3, typename S::F r4) {
+  return S::add(S::mul(r2, S::set1(6.f)),
+                S::add(S::mul(S::add(r1, r3), S::set1(4.f)), S::add(r0, r4)));
+}
+// Vertically: ((r1 + r3) + r2) * 4 + ((r0 + r4) + (r2 + r2)), then x 1/256.
+template <class S>
+ROIFLOW_INLINE typename S::F down_v_vector(typename S::F r0, typename S::F r1, typename S::F r2,
+                                           typename S::F r3, typename S::F r4) {
+  const typename S::F t = S::add(S::mul(S::add(S::add(r1, r3), r2), S::set1(4.f)),
+                                 S::add(S::add(r0, r4), S::add(r2, r2)));
+  return S::mul(t, S::set1(1.f / 256.f));
+}
+
+// The columns x = 1, 1 + N, ... of pyr_down_h's vector order whose loads stay inside the row, by
+// even and odd lanes of two vectors; returns the first column not made.
+template <class S>
+int pyr_down_h_vectors(const float* src, int w, int vend, float* row) {
+  int x = 1;
+  if constexpr (S::kPermute2) {
+    constexpr int N = S::N;
+    const typename S::I even = S::addi(S::iotai(), S::iotai());
+    const typename S::I odd = S::addi(even, S::seti(1));
+    // (The last loads end at column 2x + 2N + 1 < w.)
+    for (; x + N <= vend && 2 * x + 2 * N + 2 <= w; x += N) {
+      const float* p = src + 2 * x;
+      const typename S::F a0 = S::load(p - 2), a1 = S::load(p - 2 + N);
+      const typename S::F b0 = S::load(p), b1 = S::load(p + N);
+      const typename S::F c0 = S::load(p + 2), c1 = S::load(p + 2 + N);
+      S::store(row + x, down_h_vector<S>(S::permute2(a0, a1, even), S::permute2(a0, a1, odd),
+                                         S::permute2(b0, b1, even), S::permute2(b0, b1, odd),
+                                         S::permute2(c0, c1, even)));
+    }
+  } else {
+    (void)src, (void)w, (void)vend, (void)row;
+  }
+  return x;
+}
+
+// Row `src` (w >= 8 floats) filtered and halved into row[0 .. (w + 1) / 2).
+void pyr_down_h(const float* src, int w, float* row) {
+  using S = Native;
+  const int dw = (w + 1) / 2;
+  auto px = [&](int i) { return src[i < 0 ? -i : (i >= w ? 2 * w - 2 - i : i)]; };
+  auto scalar = [&](int x) {
+    const int c = 2 * x;
+    return down_scalar(px(c - 2), px(c - 1), px(c), px(c + 1), px(c + 2));
+  };
+  // OpenCV: column 0 by its scalar code (the left border), then its vector loop from column 1
+  // in steps of 4 while inside width0, then the scalar code.
+  const int width0 = imin((w - 3) / 2 + 1, dw);
+  const int vend = width0 > 1 ? 1 + (width0 - 1) / 4 * 4 : 1;
+  row[0] = scalar(0);
+  int x = pyr_down_h_vectors<S>(src, w, vend, row);
+  for (; x < vend; ++x) {
+    const float* p = src + 2 * x;
+    row[x] = down_h_vector<Scalar>(p[-2], p[-1], p[0], p[1], p[2]);
+  }
+  for (; x < dw; ++x)
+    row[x] = scalar(x);
+}
+
+// Row `dst` (dw floats) from the five filtered rows 2y - 2 .. 2y + 2 (reflected at the borders).
+void pyr_down_v(const float* const* rows, int dw, float* dst) {
+  using S = Native;
+  const float *r0 = rows[0], *r1 = rows[1], *r2 = rows[2], *r3 = rows[3], *r4 = rows[4];
+  // OpenCV's vector loop covers the columns below dw / 4 * 4.
+  const int vend = dw / 4 * 4;
+  int x = 0;
+  for (; x + S::N <= vend; x += S::N) {
+    S::store(dst + x, down_v_vector<S>(S::load(r0 + x), S::load(r1 + x), S::load(r2 + x),
+                                       S::load(r3 + x), S::load(r4 + x)));
+  }
+  for (; x < vend; ++x)
+    dst[x] = down_v_vector<Scalar>(r0[x], r1[x], r2[x], r3[x], r4[x]);
+  for (; x < dw; ++x)
+    dst[x] = down_scalar(r0[x], r1[x], r2[x], r3[x], r4[x]) * (1.f / 256.f);
+}
+
 }  // namespace
 }  // namespace roiflow::flow::detail

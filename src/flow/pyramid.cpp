@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -51,13 +52,72 @@ void unit_row(const detail::LkKernels& kernels, const cv::Mat& image, int y, flo
   }
 }
 
+// cv::pyrDown of a float image whose rows arrive in order (push(y, row) for y = 0 .. h - 1), by
+// the kernels' two row steps: each row halved into a ring of 8, and output row j made as soon as
+// the rows 2j - 2 .. 2j + 2 it reads (reflected at the borders) are in. The same floats as
+// cv::pyrDown.
+class RowDownsampler {
+ public:
+  // Whether the kernels have the row steps and the image is large enough for them.
+  static bool available(const detail::LkKernels& kernels, int w, int h) {
+    return kernels.pyr_down_h != nullptr && w >= 8 && h >= 3;
+  }
+
+  RowDownsampler(const detail::LkKernels& kernels, int w, int h, cv::Mat& dst)
+      : kernels_(kernels), w_(w), h_(h), dw_((w + 1) / 2), dst_(dst) {
+    dst.create((h + 1) / 2, dw_, CV_32F);
+    thread_local std::vector<float> ring;
+    ring.resize(static_cast<std::size_t>(8) * dw_);
+    ring_ = ring.data();
+  }
+
+  void push(int y, const float* row) {
+    kernels_.pyr_down_h(row, w_, halved(y));
+    for (; next_ < dst_.rows && y >= std::min(2 * next_ + 2, h_ - 1); ++next_) {
+      const float* rows[5];
+      for (int i = 0; i < 5; ++i) {
+        int r = 2 * next_ - 2 + i;
+        r = r < 0 ? -r : (r >= h_ ? 2 * h_ - 2 - r : r);
+        rows[i] = halved(r);
+      }
+      kernels_.pyr_down_v(rows, dw_, dst_.ptr<float>(next_));
+    }
+  }
+
+ private:
+  float* halved(int y) const { return ring_ + static_cast<std::size_t>(y & 7) * dw_; }
+
+  const detail::LkKernels& kernels_;
+  int w_, h_, dw_;
+  cv::Mat& dst_;
+  float* ring_ = nullptr;
+  int next_ = 0;  // the next output row
+};
+
+// dst = cv::pyrDown(src) for a float image (by the kernels where they can).
+void pyr_down(const cv::Mat& src, cv::Mat& dst) {
+  const detail::LkKernels& kernels = detail::lk_kernels();
+  if (src.type() != CV_32FC1 || !RowDownsampler::available(kernels, src.cols, src.rows) ||
+      src.data == dst.data) {
+    cv::pyrDown(src, dst);
+    return;
+  }
+  RowDownsampler down(kernels, src.cols, src.rows, dst);
+  for (int y = 0; y < src.rows; ++y)
+    down.push(y, src.ptr<float>(y));
+}
+
 // The pretreatment for a kernel of radius R (1..4): `image` in [0, 1], smoothed by the separable
 // Gaussian `k` (2R + 1 taps, borders replicated), in one pass over the rows: each row is scaled
 // and filtered horizontally into a ring of 2R + 1 rows, and each output row is the vertical sum
 // over the ring. Each output pixel depends only on its neighbourhood, never on where the image
 // (a part of a frame) starts, so pyramids of parts of a frame equal the whole frame's inside
 // them.
-void smooth_to_unit_float(const cv::Mat& image, const float* k, int R, cv::Mat& out) {
+//
+// With `down`, the next pyramid level is made too (cv::pyrDown of `out`) from each row of `out`
+// while it is in the cache; returns whether it was (false: the kernels cannot).
+bool smooth_to_unit_float(const cv::Mat& image, const float* k, int R, cv::Mat& out,
+                          cv::Mat* down) {
   const detail::LkKernels& kernels = detail::lk_kernels();
   const int taps = 2 * R + 1;
   const int w = image.cols, h = image.rows;
@@ -68,6 +128,8 @@ void smooth_to_unit_float(const cv::Mat& image, const float* k, int R, cv::Mat& 
   auto filtered = [&](int row) { return ring.data() + static_cast<std::size_t>(row % taps) * w; };
   const float* rows[9];
   out.create(h, w, CV_32F);
+  std::optional<RowDownsampler> downsampler;
+  if (down && RowDownsampler::available(kernels, w, h)) downsampler.emplace(kernels, w, h, *down);
   // A part of a frame is a few hundred bytes of each of its rows, often not in the cache (a
   // frame just decoded on another core, or one of many in memory): asking for the rows a few
   // ahead of the one filtered keeps the loads from waiting on memory one row at a time. (Inline:
@@ -93,7 +155,9 @@ void smooth_to_unit_float(const cv::Mat& image, const float* k, int R, cv::Mat& 
     for (int j = 0; j < taps; ++j)
       rows[j] = filtered(std::clamp(y - R + j, 0, h - 1));
     kernels.smooth_v(rows, k, R, w, out.ptr<float>(y));
+    if (downsampler) downsampler->push(y, out.ptr<float>(y));
   }
+  return downsampler.has_value();
 }
 
 // Level 0: `image` (8-bit gray or BGR, 16-bit or float gray) as float in [0, 1], smoothed by a
@@ -102,7 +166,9 @@ void smooth_to_unit_float(const cv::Mat& image, const float* k, int R, cv::Mat& 
 // starts with it, and at the paper's sigma 0.5 OpenCV's conversion + GaussianBlur take
 // 1.7-1.8x as long (bench/flow_bench BM_Pretreatment, VGA and 720p). Wider kernels by OpenCV;
 // both compute the same up to float rounding (~2e-7).
-void base_level(const cv::Mat& image, double sigma, cv::Mat& out) {
+//
+// With `down`, level 1 is made along with level 0 where the fused pass can (returns whether).
+bool base_level(const cv::Mat& image, double sigma, cv::Mat& out, cv::Mat* down) {
   cv::Mat gray;
   switch (image.type()) {
     case CV_8UC1:
@@ -124,7 +190,7 @@ void base_level(const cv::Mat& image, double sigma, cv::Mat& out) {
     if (kernel.second.empty() || kernel.first != sigma) {
       kernel = {sigma, cv::getGaussianKernel(ksize, sigma, CV_32F)};
     }
-    return smooth_to_unit_float(gray, kernel.second.ptr<float>(), ksize / 2, out);
+    return smooth_to_unit_float(gray, kernel.second.ptr<float>(), ksize / 2, out, down);
   }
   out.create(gray.size(), CV_32F);
   const detail::LkKernels& kernels = detail::lk_kernels();
@@ -133,17 +199,22 @@ void base_level(const cv::Mat& image, double sigma, cv::Mat& out) {
   if (ksize > 0) {
     cv::GaussianBlur(out, out, cv::Size(ksize, ksize), sigma, sigma, cv::BORDER_REPLICATE);
   }
+  return false;
+}
+
+void check_sigma(const cv::Mat& image, double sigma) {
+  if (image.empty()) throw Error("image is empty");
+  if (!(sigma >= 0.0 && sigma <= 20.0)) {
+    throw Error("smoothing sigma must be in [0, 20], got " + std::to_string(sigma));
+  }
 }
 
 }  // namespace
 
 void build_base_level(const cv::Mat& image, int levels, double sigma, Pyramid& out) {
-  if (image.empty()) throw Error("image is empty");
-  if (!(sigma >= 0.0 && sigma <= 20.0)) {
-    throw Error("smoothing sigma must be in [0, 20], got " + std::to_string(sigma));
-  }
+  check_sigma(image, sigma);
   out.levels.resize(effective_levels(image.size(), levels));
-  base_level(image, sigma, out.levels[0]);
+  base_level(image, sigma, out.levels[0], nullptr);
 }
 
 void build_level(Pyramid& pyr, int level) {
@@ -151,12 +222,16 @@ void build_level(Pyramid& pyr, int level) {
     throw Error("pyramid level " + std::to_string(level) + " is outside 1.." +
                 std::to_string(pyr.num_levels() - 1));
   }
-  cv::pyrDown(pyr.levels[level - 1], pyr.levels[level]);
+  pyr_down(pyr.levels[level - 1], pyr.levels[level]);
 }
 
+// Level 1 is made in the pass that makes level 0 (its rows while they are in the cache).
 void build_pyramid(const cv::Mat& image, int levels, double sigma, Pyramid& out) {
-  build_base_level(image, levels, sigma, out);
-  for (int l = 1; l < out.num_levels(); ++l)
+  check_sigma(image, sigma);
+  out.levels.resize(effective_levels(image.size(), levels));
+  cv::Mat* down = out.num_levels() > 1 ? &out.levels[1] : nullptr;
+  const bool fused = base_level(image, sigma, out.levels[0], down);
+  for (int l = fused ? 2 : 1; l < out.num_levels(); ++l)
     build_level(out, l);
 }
 

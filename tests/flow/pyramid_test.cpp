@@ -10,6 +10,7 @@
 
 #include "core/error.hpp"
 #include "flow/dense_lk.hpp"
+#include "flow/lk_kernels.hpp"
 #include "test_util.hpp"
 
 namespace roiflow::flow {
@@ -193,6 +194,33 @@ TEST(PyramidTest, LevelZeroIsTheInputAndCoarserLevelsArePyrDown) {
   cv::meanStdDev(smooth.levels[0], smooth_mean, smooth_std);
   EXPECT_LT(smooth_std[0], 0.5 * raw_std[0]);
   EXPECT_NEAR(smooth_mean[0], raw_mean[0], 0.01);
+}
+
+// Level 1 is made in the pass that makes level 0, and the coarser levels by the kernels' row
+// steps: both must give cv::pyrDown's floats exactly, whatever the size (odd sides, rows that
+// end inside a vector, frames narrower than two vectors), with every instruction set.
+TEST(PyramidTest, FusedLevelsAreCvPyrDownBitForBit) {
+  const cv::Size sizes[] = {{640, 480}, {584, 388}, {1242, 375}, {621, 188}, {83, 61},
+                            {37, 29},   {13, 9},    {9, 7},      {8, 3},     {71, 33}};
+  const detail::LkKernels* kinds[8];
+  const int n = detail::available_lk_kernels(kinds, 8);
+  for (int k = 0; k < n; ++k) {
+    detail::set_lk_kernels_for_testing(kinds[k]);
+    for (const cv::Size size : sizes) {
+      const cv::Mat image = random_image(size, CV_8UC1, 11);
+      for (const double sigma : {0.5, 0.0}) {
+        const Pyramid pyr = build_pyramid(image, 4, sigma);
+        for (int l = 1; l < pyr.num_levels(); ++l) {
+          cv::Mat down;
+          cv::pyrDown(pyr.levels[l - 1], down);
+          ASSERT_EQ(pyr.levels[l].size(), down.size());
+          EXPECT_EQ(cv::norm(pyr.levels[l], down, cv::NORM_INF), 0.0)
+              << kinds[k]->name << " " << size << " sigma " << sigma << " level " << l;
+        }
+      }
+    }
+  }
+  detail::set_lk_kernels_for_testing(nullptr);
 }
 
 TEST(PyramidTest, RejectsEmptyImagesAndOtherTypes) {
