@@ -184,24 +184,33 @@ ROIFLOW_INLINE typename S::F down_v_vector(typename S::F r0, typename S::F r1, t
   return S::mul(t, S::set1(1.f / 256.f));
 }
 
-// The columns x = 1, 1 + N, ... of pyr_down_h's vector order whose loads stay inside the row, by
-// even and odd lanes of two vectors; returns the first column not made.
+// The columns x = 1, 1 + N, ... of pyr_down_h's vector order whose loads stay inside the row,
+// from the even and odd columns of two vectors (E, O: columns 2x - 2 + 2i and 2x - 1 + 2i) and
+// those of the next block (E', O'): r0 = E, r1 = O, r2 = E shifted one lane on into E', r3 the
+// same of O, r4 two lanes on. Two loads and five shuffles per vector; returns the first column
+// not made.
 template <class S>
 int pyr_down_h_vectors(const float* src, int w, int vend, float* row) {
   int x = 1;
   if constexpr (S::kPermute2) {
+    using F = typename S::F;
+    using I = typename S::I;
     constexpr int N = S::N;
-    const typename S::I even = S::addi(S::iotai(), S::iotai());
-    const typename S::I odd = S::addi(even, S::seti(1));
-    // (The last loads end at column 2x + 2N + 1 < w.)
-    for (; x + N <= vend && 2 * x + 2 * N + 2 <= w; x += N) {
-      const float* p = src + 2 * x;
-      const typename S::F a0 = S::load(p - 2), a1 = S::load(p - 2 + N);
-      const typename S::F b0 = S::load(p), b1 = S::load(p + N);
-      const typename S::F c0 = S::load(p + 2), c1 = S::load(p + 2 + N);
-      S::store(row + x, down_h_vector<S>(S::permute2(a0, a1, even), S::permute2(a0, a1, odd),
-                                         S::permute2(b0, b1, even), S::permute2(b0, b1, odd),
-                                         S::permute2(c0, c1, even)));
+    const I even = S::addi(S::iotai(), S::iotai());
+    const I odd = S::addi(even, S::seti(1));
+    const I two = S::addi(S::iotai(), S::seti(2));
+    // (The next block's loads end at column 2x + 4N - 3 < w.)
+    if (!(x + N <= vend && 2 * x + 4 * N - 2 <= w)) return x;
+    F a0 = S::load(src + 2 * x - 2), a1 = S::load(src + 2 * x - 2 + N);
+    F e = S::permute2(a0, a1, even), o = S::permute2(a0, a1, odd);
+    for (; x + N <= vend && 2 * x + 4 * N - 2 <= w; x += N) {
+      const float* p = src + 2 * x - 2 + 2 * N;
+      const F b0 = S::load(p), b1 = S::load(p + N);
+      const F e1 = S::permute2(b0, b1, even), o1 = S::permute2(b0, b1, odd);
+      S::store(row + x,
+               down_h_vector<S>(e, o, S::next1(e, e1), S::next1(o, o1), S::permute2(e, e1, two)));
+      e = e1;
+      o = o1;
     }
   } else {
     (void)src, (void)w, (void)vend, (void)row;
