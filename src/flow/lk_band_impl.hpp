@@ -12,6 +12,7 @@
 
 #include "flow/lk_kernels.hpp"
 #include "flow/lk_kernels_impl.hpp"
+#include "flow/lk_pairs_impl.hpp"
 #include "flow/lk_rows_impl.hpp"
 
 #ifndef ROIFLOW_KERNEL_TABLE
