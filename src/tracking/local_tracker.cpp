@@ -220,6 +220,7 @@ double LocalTracker::Impl::backward_check(const cv::Rect& object, cv::Point2f ro
   flow::FlowOptions opt;
   opt.context = params.lk_context;
   opt.finest_level = lk_level;
+  opt.confidence = false;  // only the way back is read (the flow is the same without it)
   if (params.whole_frame) {
     opt.region = frame_rect();
   } else {

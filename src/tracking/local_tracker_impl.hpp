@@ -145,14 +145,16 @@ class ScaledTemplates {
     for (const auto& [s, m] : sizes_) {
       if (s == size) return m;
     }
-    if (sizes_.size() >= kKept) sizes_.clear();
+    // The oldest size goes first (clearing them all made the wide size check's 17 sizes, and
+    // the step's 11 as the box's size drifts, be resized again and again).
+    if (sizes_.size() >= kKept) sizes_.erase(sizes_.begin());
     sizes_.emplace_back(size, DirectTemplate(resize_template(templ, size)));
     return sizes_.back().second;
   }
   void clear() { sizes_.clear(); }
 
  private:
-  static constexpr std::size_t kKept = 16;
+  static constexpr std::size_t kKept = 24;
   std::vector<std::pair<cv::Size, DirectTemplate>> sizes_;
 };
 

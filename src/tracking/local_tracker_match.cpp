@@ -207,15 +207,25 @@ bool LocalTracker::Impl::check_size(const LocalFrame& in, cv::Rect2f& b) {
   cover(in,
         match_need(templ, box_at(c, b.size() * static_cast<float>(std::pow(kStep, kSteps))), 1.0));
   const cv::Point origin = next_part.rect.tl();
-  double own = -1;
+  auto at_size = [&](int j) {
+    return match(templ, wide_sizes, view_next, origin,
+                 box_at(c, b.size() * static_cast<float>(std::pow(kStep, j))), 1.0, 0);
+  };
+  // The box's own size first: an NCC is at most 1, so above 1 - scale_check_margin no size can
+  // beat it by the margin (and without one none is taken): the other sizes, most of the check's
+  // cost, are not searched. The same outcome as searching them.
+  const Appearance own_match = at_size(0);
+  const double own = own_match.score;
+  if (!(own > -1) || own + params.scale_check_margin > 1.0) {
+    size_pending = 0;
+    return false;
+  }
   Appearance best;
   double best_ratio = 1;
   int best_j = 0;
   for (int j = lowest; j <= kSteps; ++j) {
     const double k = std::pow(kStep, j);
-    const Appearance a = match(templ, wide_sizes, view_next, origin,
-                               box_at(c, b.size() * static_cast<float>(k)), 1.0, 0);
-    if (j == 0) own = a.score;
+    const Appearance a = j == 0 ? own_match : at_size(j);
     if (a.score > best.score) {
       best = a;
       best_ratio = k * a.size_ratio;
