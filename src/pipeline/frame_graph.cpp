@@ -467,11 +467,9 @@ namespace {
 // frame wants it.
 class StartFlowNode {
  public:
-  // `stripes` runs each frame's LK in row stripes (the result is the same at any thread count).
-  StartFlowNode(tf::graph& g, Run& run, const tracking::MultiTrackerParams& params,
-                const Executor* stripes)
+  StartFlowNode(tf::graph& g, Run& run, const tracking::MultiTrackerParams& params)
       : params_(params),
-        lk_(params.lk, stripes),
+        lk_(params.lk, &stripes_),
         node_(g, tf::serial, [this, &run](const FrameMsg& m) { return step(run, m); }) {}
   tf::function_node<FrameMsg, StartMsg>& node() { return node_; }
 
@@ -493,6 +491,7 @@ class StartFlowNode {
   }
 
   const tracking::MultiTrackerParams& params_;
+  const TbbExecutor stripes_;  // the LK's row stripes on the arena's threads (same result)
   flow::DenseLK lk_;
   std::shared_ptr<flow::Pyramid> previous_;
   tf::function_node<FrameMsg, StartMsg> node_;
@@ -504,10 +503,9 @@ class StartFlowNode {
 class SplitNode {
  public:
   using Met = std::tuple<SeenMsg, DecidedMsg>;
-  SplitNode(tf::graph& g, Run& run, const tracking::MultiTrackerParams& params,
-            const Executor* stripes)
+  SplitNode(tf::graph& g, Run& run, const tracking::MultiTrackerParams& params)
       : params_(params),
-        lk_(params.lk, stripes),
+        lk_(params.lk, &stripes_),
         node_(g, tf::serial, [this, &run](Met in) { return step(run, std::move(in)); }) {}
   tf::function_node<Met, Met>& node() { return node_; }
 
@@ -532,6 +530,7 @@ class SplitNode {
   }
 
   const tracking::MultiTrackerParams& params_;
+  const TbbExecutor stripes_;  // the LK's row stripes on the arena's threads (same result)
   flow::DenseLK lk_;
   tf::function_node<Met, Met> node_;
 };
@@ -546,9 +545,7 @@ RunReport run_mot(const FrameSource& source, const tracking::MultiTrackerParams&
     tf::graph g;
     FrontEnd front(g, run, source, limit, params.lk.levels, params.lk.sigma);
 
-    // Whole-frame and whole-box LK in serial nodes runs in row stripes on the arena's threads.
-    const TbbExecutor stripes;
-    StartFlowNode start_flow(g, run, params, &stripes);  // the scene start's flow, then
+    StartFlowNode start_flow(g, run, params);  // the scene start's flow, then
     // background refresh: serial, in frame order (the model learns the frames in order).
     tracking::MotionDetector detector(params.detector);
     tf::function_node<StartMsg, SeenMsg> background(g, tf::serial, [&](const StartMsg& m) {
@@ -572,7 +569,7 @@ RunReport run_mot(const FrameSource& source, const tracking::MultiTrackerParams&
         g, [](const SeenMsg& m) { return static_cast<std::size_t>(m.seq); });
     // Frame t+1 meets the decisions at t (the feedback edge), then the motion split.
     tf::join_node<std::tuple<SeenMsg, DecidedMsg>, tf::queueing> meet(g);
-    SplitNode split(g, run, params, &stripes);
+    SplitNode split(g, run, params);
     using PlanNode =
         tf::multifunction_node<std::tuple<SeenMsg, DecidedMsg>, std::tuple<TileMsg, CollectMsg>>;
     PlanNode plan(g, tf::serial, [&](const std::tuple<SeenMsg, DecidedMsg>& in, auto& ports) {
