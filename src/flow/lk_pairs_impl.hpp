@@ -10,6 +10,24 @@
 namespace roiflow::flow::detail {
 namespace {
 
+// The pairs of the vector at column x from its m, d, u, v (…0) and the next vector's (…2); then
+// the next vector becomes the current one.
+ROIFLOW_INLINE void store_pairs(float* pairs, int x, Native::F& m0, Native::F& d0, Native::F& u0,
+                                Native::F& v0, Native::F m2, Native::F d2, Native::F u2,
+                                Native::F v2) {
+  using S = Native;
+  const Native::F m1 = S::next1(m0, m2);
+  S::store(at(pairs, x, 0), S::sub(m1, m0));
+  S::store(at(pairs, x, 1), S::add(m0, m1));
+  S::store(at(pairs, x, 2), S::add(d0, S::next1(d0, d2)));
+  S::store(at(pairs, x, 3), S::add(u0, S::next1(u0, u2)));
+  S::store(at(pairs, x, 4), S::add(v0, S::next1(v0, v2)));
+  m0 = m2;
+  d0 = d2;
+  u0 = u2;
+  v0 = v2;
+}
+
 // Horn–Schunck works on the 2x2x2 cube between warped rows s, s + 1 and columns x, x + 1 (grid
 // at +1/2). Each warped row's column pairs are formed once (it serves two derivative-grid rows):
 // Dm = m[x+1] - m[x], Sm = m[x] + m[x+1], Sd, Su, Sv likewise (interleaved like the ring). Flow
@@ -25,16 +43,7 @@ void hs_pairs(int x0, int x1, const float* m, const float* d, const float* u, co
   for (int x = x0; x < x1; x += S::N) {
     const int n = x + S::N;
     const F m2 = S::load(m + n), d2 = S::load(d + n), u2 = S::load(u + n), v2 = S::load(v + n);
-    const F m1 = S::next1(m0, m2);
-    S::store(at(pairs, x, 0), S::sub(m1, m0));
-    S::store(at(pairs, x, 1), S::add(m0, m1));
-    S::store(at(pairs, x, 2), S::add(d0, S::next1(d0, d2)));
-    S::store(at(pairs, x, 3), S::add(u0, S::next1(u0, u2)));
-    S::store(at(pairs, x, 4), S::add(v0, S::next1(v0, v2)));
-    m0 = m2;
-    d0 = d2;
-    u0 = u2;
-    v0 = v2;
+    store_pairs(pairs, x, m0, d0, u0, v0, m2, d2, u2, v2);
   }
 }
 
@@ -64,17 +73,7 @@ void warp_pairs_row(const LevelJob& L, int y, const float* u, const float* v, fl
     F m2, d2;
     warp_values<S>(g, static_cast<float>(L.x0 + x), fy, u + x, v + x, i0 + x, true, m2, d2);
     const F u2 = S::load(u + x), v2 = S::load(v + x);
-    const F m1 = S::next1(m0, m2);
-    const int p = x - N;
-    S::store(at(pairs, p, 0), S::sub(m1, m0));
-    S::store(at(pairs, p, 1), S::add(m0, m1));
-    S::store(at(pairs, p, 2), S::add(d0, S::next1(d0, d2)));
-    S::store(at(pairs, p, 3), S::add(u0, S::next1(u0, u2)));
-    S::store(at(pairs, p, 4), S::add(v0, S::next1(v0, v2)));
-    m0 = m2;
-    d0 = d2;
-    u0 = u2;
-    v0 = v2;
+    store_pairs(pairs, x - N, m0, d0, u0, v0, m2, d2, u2, v2);
   }
   // The last whole vector (at x - N), the columns after it and the replicated column w through
   // memory, as warp_row leaves them; their pairs as hs_pairs makes them.
