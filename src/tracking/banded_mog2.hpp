@@ -1,10 +1,8 @@
-// OpenCV's MOG2 background model (cv::BackgroundSubtractorMOG2) learning in bands of rows: each
-// band of at least 32 rows has a model of its own, and the bands learn in parallel on the
-// caller's threads (cv::parallel_for_, which runs in the oneTBB arena of the graph that calls
-// it). MOG2 models each pixel alone, so the mask is the one a single model over the whole frame
-// gives, at any thread count; OpenCV itself runs a frame under 65536 pixels (the tracker's
-// working size) on one thread, which made the background refresh the serial bound of tracking
-// on many cores.
+// OpenCV's MOG2 background model (cv::BackgroundSubtractorMOG2) in bands of rows: each band of
+// at least 32 rows has a model of its own. MOG2 models each pixel alone, so the mask is the one a
+// single model over the whole frame gives. The bands are independent work: run in parallel
+// (measured on 16 cores, docs/TRACKING.md) they lift the serial background node that bounds
+// tracking on many cores; for now they run one after the other (see banded_mog2.cpp).
 //
 //   roiflow::tracking::BandedMog2Params params;  // history 500, variance threshold 16, shadows
 //   roiflow::tracking::BandedMog2 model(params);

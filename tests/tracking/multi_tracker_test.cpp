@@ -126,7 +126,7 @@ TEST(DetectObjects, AHoleInsideAnObjectIsNoValley) {
 }
 
 TEST(MotionDetector, BandsOfRowsMaskAsOneModelOverTheFrame) {
-  // The model learns in bands of rows (in parallel); MOG2 models each pixel alone, so the mask
+  // The model learns in bands of rows; MOG2 models each pixel alone, so the mask
   // is the one a single model over the whole frame gives, at any thread count. The comparison
   // needs the detector's own steps off (ghosts, scene start, opening) and the frame at its
   // working size.
