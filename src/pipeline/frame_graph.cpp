@@ -497,6 +497,32 @@ class StartFlowNode {
   tf::function_node<FrameMsg, StartMsg> node_;
 };
 
+// The background refresh: the motion detector's model learns each frame, serial and in frame
+// order (the model learns the frames in order); its bands of rows run at once on the arena's
+// threads (the same masks).
+class BackgroundNode {
+ public:
+  BackgroundNode(tf::graph& g, Run& run, const tracking::MultiTrackerParams& params)
+      : detector_(params.detector),
+        node_(g, tf::serial, [this, &run](const StartMsg& m) { return step(run, m); }) {}
+  tf::function_node<StartMsg, SeenMsg>& node() { return node_; }
+
+ private:
+  SeenMsg step(Run& run, const StartMsg& m) {
+    run.enter(Stage::Track, m.seq);
+    const auto t0 = Clock::now();
+    SeenMsg out{m.seq, m.frame, nullptr, nullptr};
+    out.fg = std::make_shared<const tracking::Foreground>(
+        detector_.observe(m.frame.frame->picture(), m.back.get(), &bands_));
+    run.time("background", t0);
+    return out;
+  }
+
+  tracking::MotionDetector detector_;
+  const TbbExecutor bands_;
+  tf::function_node<StartMsg, SeenMsg> node_;
+};
+
 // The motion split (after the scene start) of the detections the objects at t say are wrong
 // (tracking::split_candidates): dense LK over each one's box, serial (frames meet their
 // decisions one at a time), between the meeting of frame t+1 with the decisions at t and the plan.
@@ -545,18 +571,8 @@ RunReport run_mot(const FrameSource& source, const tracking::MultiTrackerParams&
     tf::graph g;
     FrontEnd front(g, run, source, limit, params.lk.levels, params.lk.sigma);
 
-    StartFlowNode start_flow(g, run, params);  // the scene start's flow, then
-    // background refresh: serial, in frame order (the model learns the frames in order).
-    tracking::MotionDetector detector(params.detector);
-    tf::function_node<StartMsg, SeenMsg> background(g, tf::serial, [&](const StartMsg& m) {
-      run.enter(Stage::Track, m.seq);
-      const auto t0 = Clock::now();
-      SeenMsg out{m.seq, m.frame, nullptr, nullptr};
-      out.fg = std::make_shared<const tracking::Foreground>(
-          detector.observe(m.frame.frame->picture(), m.back.get()));
-      run.time("background", t0);
-      return out;
-    });
+    StartFlowNode start_flow(g, run, params);   // the scene start's flow, then
+    BackgroundNode background(g, run, params);  // the background refresh
     // Global treatment: the moving objects of each frame, several frames at once.
     tf::function_node<SeenMsg, SeenMsg> global(g, tf::unlimited, [&](SeenMsg m) {
       const auto t0 = Clock::now();
@@ -632,8 +648,8 @@ RunReport run_mot(const FrameSource& source, const tracking::MultiTrackerParams&
     RetireNode retire = make_retire_node(g, run, static_cast<int>(sink_nodes.size()));
 
     tf::make_edge(front.output(), start_flow.node());
-    tf::make_edge(start_flow.node(), background);
-    tf::make_edge(background, global);
+    tf::make_edge(start_flow.node(), background.node());
+    tf::make_edge(background.node(), global);
     tf::make_edge(global, seen_order);
     tf::make_edge(seen_order, tf::input_port<0>(meet));
     tf::make_edge(meet, split.node());

@@ -15,9 +15,12 @@ constexpr int kMaxBands = 16;
 
 }  // namespace
 
-void BandedMog2::apply(const cv::Mat& image, cv::Mat& mask, double learning_rate) {
+void BandedMog2::apply(const cv::Mat& image, cv::Mat& mask, double learning_rate,
+                       const Executor* executor) {
   if (models_.empty()) {
-    const int count = std::clamp(image.rows / kBandRows, 1, kMaxBands);
+    // One band per thread that can run one: more would only add models and their setup.
+    const int threads = executor != nullptr ? std::min(executor->concurrency(), kMaxBands) : 1;
+    const int count = std::clamp(image.rows / kBandRows, 1, std::max(threads, 1));
     for (int i = 0; i < count; ++i) {
       bands_.emplace_back(image.rows * i / count, image.rows * (i + 1) / count);
       models_.push_back(cv::createBackgroundSubtractorMOG2(params_.history, params_.var_threshold,
@@ -30,12 +33,21 @@ void BandedMog2::apply(const cv::Mat& image, cv::Mat& mask, double learning_rate
                 " rows after frames of " + std::to_string(bands_.back().end));
   }
   mask.create(image.size(), CV_8U);
-  // One band after the other: the bands learnt in parallel through cv::parallel_for_ gave TSan
-  // reports (OpenCV's loop joins are not instrumented) inside the graph's nodes; they are to run
-  // on roiflow's own executor instead.
-  for (std::size_t i = 0; i < models_.size(); ++i) {
-    cv::Mat band = mask.rowRange(bands_[i]);
-    models_[i]->apply(image.rowRange(bands_[i]), band, learning_rate);
+  // The bands on roiflow's executor, not cv::parallel_for_: inside the graph's nodes OpenCV's
+  // loop joins are not instrumented for ThreadSanitizer, TBB's are. A band under MOG2's
+  // 65536-pixel stripe (320 columns by up to 204 rows) runs on the calling thread.
+  const auto run = [&](int begin, int end) {
+    for (int i = begin; i < end; ++i) {
+      const auto b = static_cast<std::size_t>(i);
+      cv::Mat band = mask.rowRange(bands_[b]);
+      models_[b]->apply(image.rowRange(bands_[b]), band, learning_rate);
+    }
+  };
+  const int count = static_cast<int>(models_.size());
+  if (count > 1 && executor != nullptr) {
+    executor->for_range(0, count, 1, run);
+  } else {
+    run(0, count);
   }
 }
 

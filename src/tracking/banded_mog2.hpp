@@ -1,20 +1,26 @@
 // OpenCV's MOG2 background model (cv::BackgroundSubtractorMOG2) in bands of rows: each band of
 // at least 32 rows has a model of its own. MOG2 models each pixel alone, so the mask is the one a
-// single model over the whole frame gives. The bands are independent work: run in parallel
-// (measured on 16 cores, docs/TRACKING.md) they lift the serial background node that bounds
-// tracking on many cores; for now they run one after the other (see banded_mog2.cpp).
+// single model over the whole frame gives. The bands are independent work: given an executor
+// that runs bodies at once (concurrency() > 1), the frame is cut into up to one band per thread
+// and the bands learn in parallel through it (the MOT graph passes its TbbExecutor, which lifts
+// the serial background node that bounds tracking on many cores). Without one, or with a serial
+// one, there is a single band: plain MOG2, with one model's memory.
 //
 //   roiflow::tracking::BandedMog2Params params;  // history 500, variance threshold 16, shadows
 //   roiflow::tracking::BandedMog2 model(params);
 //   cv::Mat mask;  // CV_8U: 255 foreground, 127 shadow, 0 background
 //   model.apply(frame_t, mask);         // MOG2's own learning rate
 //   model.apply(frame_t1, mask, 0.01);  // or a given one
+//   const roiflow::SerialExecutor serial;  // a parallel executor: bands at once
+//   model.apply(frame_t1, mask, -1, &serial);
 #pragma once
 
 #include <opencv2/core.hpp>
 #include <opencv2/video/background_segm.hpp>
 #include <optional>
 #include <vector>
+
+#include "core/executor.hpp"
 
 namespace roiflow::tracking {
 
@@ -29,8 +35,10 @@ struct BandedMog2Params {
 class BandedMog2 {
  public:
   explicit BandedMog2(const BandedMog2Params& params) : params_(params) {}
-  // The frame's mask (CV_8U, frame-sized); the first frame sets the size the model keeps.
-  void apply(const cv::Mat& image, cv::Mat& mask, double learning_rate = -1);
+  // The frame's mask (CV_8U, frame-sized); the first frame sets the size the model keeps, and
+  // the bands (from `executor`'s concurrency then). `executor` (may be null) runs the bands.
+  void apply(const cv::Mat& image, cv::Mat& mask, double learning_rate = -1,
+             const Executor* executor = nullptr);
 
  private:
   BandedMog2Params params_;

@@ -343,7 +343,8 @@ bool MotionDetector::wants_flow() const {
   return tracking::wants_flow(params_, impl_->observed);
 }
 
-Foreground MotionDetector::observe(const cv::Mat& image, const flow::FlowResult* flow_back) {
+Foreground MotionDetector::observe(const cv::Mat& image, const flow::FlowResult* flow_back,
+                                   const Executor* executor) {
   if (image.empty() || image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3))
     throw Error("motion detector: frame must be 8-bit gray or BGR");
   Impl& s = *impl_;
@@ -366,7 +367,7 @@ Foreground MotionDetector::observe(const cv::Mat& image, const flow::FlowResult*
                cv::INTER_AREA);
     input = &s.small;
   }
-  s.model.apply(*input, s.raw);
+  s.model.apply(*input, s.raw, -1, executor);
   ++s.observed;
   Foreground fg;
   fg.observed = s.observed;

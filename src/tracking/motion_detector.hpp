@@ -30,6 +30,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "core/executor.hpp"
 #include "flow/dense_lk.hpp"
 #include "tracking/global_detector.hpp"
 
@@ -131,7 +132,10 @@ class MotionDetector {
   // `back` (given when wants_flow() said so, else ignored): dense LK from this frame back to the
   // previous one over the whole frame, flow (CV_32FC2: per pixel of `image` its displacement to
   // the previous frame) and confidence (CV_32F, the window's smallest structure eigenvalue).
-  Foreground observe(const cv::Mat& image, const flow::FlowResult* back = nullptr);
+  // `executor` (may be null): runs the background model's bands of rows at once (banded_mog2.hpp);
+  // the first frame fixes their count from its concurrency. The result does not depend on it.
+  Foreground observe(const cv::Mat& image, const flow::FlowResult* back = nullptr,
+                     const Executor* executor = nullptr);
   // Whether the next observe() is in the scene start and uses the flow back to the previous
   // frame (from the second frame to the `start_frames`-th one after it, when `start_motion` > 0).
   bool wants_flow() const;

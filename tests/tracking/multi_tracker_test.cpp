@@ -8,6 +8,8 @@
 #include <opencv2/video/background_segm.hpp>
 #include <set>
 #include <sstream>
+#include <thread>
+#include <vector>
 
 #include "eval/traffic_scene.hpp"
 #include "mot_scene.hpp"
@@ -125,29 +127,52 @@ TEST(DetectObjects, AHoleInsideAnObjectIsNoValley) {
   EXPECT_EQ(found[0].box, cv::Rect2f(20, 30, 70, 30));
 }
 
+// Runs each of `threads` sub-ranges on a thread of its own: real parallel bands.
+class ThreadsExecutor final : public Executor {
+ public:
+  explicit ThreadsExecutor(int threads) : threads_(threads) {}
+  void for_range(int begin, int end, int /*grain*/,
+                 const std::function<void(int, int)>& body) const override {
+    std::vector<std::thread> pool;
+    const int n = end - begin;
+    for (int i = 0; i < threads_; ++i) {
+      const int b = begin + n * i / threads_, e = begin + n * (i + 1) / threads_;
+      if (b < e) pool.emplace_back([&body, b, e] { body(b, e); });
+    }
+    for (std::thread& t : pool)
+      t.join();
+  }
+  int concurrency() const override { return threads_; }
+
+ private:
+  int threads_;
+};
+
 TEST(MotionDetector, BandsOfRowsMaskAsOneModelOverTheFrame) {
-  // The model learns in bands of rows; MOG2 models each pixel alone, so the mask
-  // is the one a single model over the whole frame gives, at any thread count. The comparison
-  // needs the detector's own steps off (ghosts, scene start, opening) and the frame at its
-  // working size.
+  // Given a parallel executor, the model learns in bands of rows at once; MOG2 models each pixel
+  // alone, so the mask is the one a single model over the whole frame gives, with any executor.
+  // The comparison needs the detector's own steps off (ghosts, scene start, opening) and the
+  // frame at its working size.
   MotScene scene({320, 240}, {{{-40, 40, 20, 50}, {3, 0}, 40}, {{230, 130, 30, 30}, {-2, 1}, 40}});
   tracking::MotionDetectorParams p;
   p.ghost_frames = 0;
   p.start_frames = 0;
   p.open = 0;
   p.work_width = 320;
-  const int previous = cv::getNumThreads();
-  for (const int threads : {1, 4}) {
-    cv::setNumThreads(threads);
+  const SerialExecutor serial;
+  const ThreadsExecutor two(2), four(4), many(16);
+  for (const Executor* executor :
+       std::vector<const Executor*>{nullptr, &serial, &two, &four, &many}) {
     tracking::MotionDetector detector(p);
     cv::Ptr<cv::BackgroundSubtractorMOG2> one =
         cv::createBackgroundSubtractorMOG2(p.history, p.var_threshold, p.shadows);
     one->setShadowThreshold(p.shadow_threshold);
     one->setBackgroundRatio(p.background_ratio);
+    const int threads = executor != nullptr ? executor->concurrency() : 0;
     int moving = 0;
     for (int t = 0; t < 60; ++t) {  // the objects enter at frame 40
       const cv::Mat frame = scene.frame(t);
-      const tracking::Foreground fg = detector.observe(frame);
+      const tracking::Foreground fg = detector.observe(frame, nullptr, executor);
       cv::Mat raw, mask;
       one->apply(frame, raw);
       cv::threshold(raw, mask, 200, 255, cv::THRESH_BINARY);
@@ -156,7 +181,6 @@ TEST(MotionDetector, BandsOfRowsMaskAsOneModelOverTheFrame) {
     }
     EXPECT_GT(moving, 1000);  // the comparison saw moving pixels
   }
-  cv::setNumThreads(previous);
 }
 // Object 0 stands still from the first frame, so that the background model learns it as
 // background; at frame 30 object 1 takes its place and drives away. Where object 0 stood then
