@@ -148,7 +148,7 @@ void GlobalDetectorParams::validate() const {
 
 struct GlobalDetector::Impl {
   GlobalDetectorParams params;
-  std::optional<BandedMog2> model;  // MOG2 in bands of rows (banded_mog2.hpp)
+  std::optional<BandedMog2> model;  // MOG2 (banded_mog2.hpp: one band, no executor here)
   cv::Size frame_size;              // of the first observed frame
   cv::Size work_size;
   cv::Point2d to_full{1, 1};  // full-resolution pixels per model pixel, in x and y
