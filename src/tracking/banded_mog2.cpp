@@ -44,8 +44,8 @@ void BandedMog2::apply(const cv::Mat& image, cv::Mat& mask, double learning_rate
     }
   };
   const int count = static_cast<int>(models_.size());
-  if (count > 1 && executor != nullptr) {
-    executor->for_range(0, count, 1, run);
+  if (count > 1) {
+    executor->for_range(0, count, 1, run);  // (several bands only where an executor was given)
   } else {
     run(0, count);
   }

@@ -11,8 +11,8 @@
 //   cv::Mat mask;  // CV_8U: 255 foreground, 127 shadow, 0 background
 //   model.apply(frame_t, mask);         // MOG2's own learning rate
 //   model.apply(frame_t1, mask, 0.01);  // or a given one
-//   const roiflow::SerialExecutor serial;  // a parallel executor: bands at once
-//   model.apply(frame_t1, mask, -1, &serial);
+//   const roiflow::SerialExecutor serial;     // one band; given a parallel executor (the
+//   model.apply(frame_t1, mask, -1, &serial);  // pipeline's TbbExecutor) the bands run at once
 #pragma once
 
 #include <opencv2/core.hpp>

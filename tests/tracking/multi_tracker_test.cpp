@@ -127,18 +127,16 @@ TEST(DetectObjects, AHoleInsideAnObjectIsNoValley) {
   EXPECT_EQ(found[0].box, cv::Rect2f(20, 30, 70, 30));
 }
 
-// Runs each of `threads` sub-ranges on a thread of its own: real parallel bands.
+// Claims `threads` and runs each chunk for_range is given on a thread of its own: real parallel
+// bands.
 class ThreadsExecutor final : public Executor {
  public:
   explicit ThreadsExecutor(int threads) : threads_(threads) {}
-  void for_range(int begin, int end, int /*grain*/,
+  void for_range(int begin, int end, int grain,
                  const std::function<void(int, int)>& body) const override {
     std::vector<std::thread> pool;
-    const int n = end - begin;
-    for (int i = 0; i < threads_; ++i) {
-      const int b = begin + n * i / threads_, e = begin + n * (i + 1) / threads_;
-      if (b < e) pool.emplace_back([&body, b, e] { body(b, e); });
-    }
+    for (const auto& [b, e] : test::chunks_of(begin, end, grain))
+      pool.emplace_back([&body, b = b, e = e] { body(b, e); });
     for (std::thread& t : pool)
       t.join();
   }
