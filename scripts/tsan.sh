@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# The concurrency tests under ThreadSanitizer: the flow-graph, stripe-executor, tracker, banded
-# background model, cancellation and soak tests, and the video decoder's and DeferredImage's
-# (colour converted on whichever thread asks first) (the tsan test preset's filter), against a
-# oneTBB built with TSan.
+# The concurrency tests under ThreadSanitizer (ROIFLOW_TEST_FILTER of the tsan preset): the
+# flow-graph, stripe-executor, tracker, banded background model, cancellation and soak tests, and
+# the video decoder's and DeferredImage's (colour converted on whichever thread asks first),
+# against a oneTBB built with TSan.
 #
 #   scripts/tsan.sh
 #
