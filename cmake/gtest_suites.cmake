@@ -103,7 +103,12 @@ function(roiflow_add_gtest_suites target)
   # A custom command's arguments split on semicolons.
   string(REPLACE ";" "|" emulator "${CMAKE_CROSSCOMPILING_EMULATOR}")
   # Bracket arguments keep the semicolons: one property value, a list.
-  set(properties "TIMEOUT 900 LABELS [==[${ARG_LABELS}]==]")
+  # A suite's cases run in one process: 15 minutes, an hour under an emulator (qemu-user).
+  set(timeout 900)
+  if(CMAKE_CROSSCOMPILING_EMULATOR)
+    set(timeout 3600)
+  endif()
+  set(properties "TIMEOUT ${timeout} LABELS [==[${ARG_LABELS}]==]")
   if(ARG_ENVIRONMENT)
     string(APPEND properties " ENVIRONMENT [==[${ARG_ENVIRONMENT}]==]")
   endif()
