@@ -16,7 +16,8 @@
 # the sanitizer presets) selects the cases: a suite with cases left out lists those it runs.
 #
 # In script mode (cmake -DEXE=... -DOUT=... -DFILTER=... -P gtest_suites.cmake) it lists the
-# binary's cases and writes the add_test() lines to OUT.
+# binary's cases and writes the add_test() lines to OUT, after checking that the suites' filters
+# together select exactly the chosen cases (else the build fails).
 
 if(CMAKE_SCRIPT_MODE_FILE)
   cmake_policy(SET CMP0057 NEW)  # IN_LIST
@@ -60,6 +61,7 @@ if(CMAKE_SCRIPT_MODE_FILE)
   endforeach()
   list(REMOVE_DUPLICATES suites)
   set(content "")
+  set(filters)
   foreach(suite IN LISTS suites)
     set(in_suite)
     set(selected_in_suite)
@@ -80,12 +82,25 @@ if(CMAKE_SCRIPT_MODE_FILE)
     else()
       list(JOIN selected_in_suite ":" filter)
     endif()
+    list(APPEND filters "${filter}")
     string(APPEND content
            "add_test([==[${PREFIX}/${suite}]==] ${EMULATOR} [==[${EXE}]==] "
            "[==[--gtest_filter=${filter}]==])\n"
            "set_tests_properties([==[${PREFIX}/${suite}]==] PROPERTIES COST ${n})\n"
            "list(APPEND ${LIST_VAR} [==[${PREFIX}/${suite}]==])\n")
   endforeach()
+  # The suites' filters together must select exactly the cases chosen: no case lost, none added.
+  list(LENGTH selected n_selected)
+  list(JOIN filters ":" union)
+  set(n_union 0)
+  if(union)
+    list_cases("${union}" by_suites)
+    list(LENGTH by_suites n_union)
+  endif()
+  if(NOT n_union EQUAL n_selected)
+    message(FATAL_ERROR "gtest_suites: ${EXE}: the suites' filters select ${n_union} cases, "
+                        "the filter '${FILTER}' ${n_selected}")
+  endif()
   file(WRITE "${OUT}" "set(${LIST_VAR})\n${content}")
   return()
 endif()
