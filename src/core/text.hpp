@@ -81,12 +81,43 @@ inline std::string number_text(double v) {
   return s.str();
 }
 
+// The length of the well-formed UTF-8 sequence of two to four bytes at the start of `s`, or 0.
+inline std::size_t utf8_sequence(std::string_view s) {
+  const auto byte = [&](std::size_t i) { return static_cast<unsigned char>(s[i]); };
+  const unsigned char lead = byte(0);
+  const std::size_t n = lead >= 0xC2 && lead <= 0xDF   ? 2
+                        : lead >= 0xE0 && lead <= 0xEF ? 3
+                        : lead >= 0xF0 && lead <= 0xF4 ? 4
+                                                       : 0;
+  if (n == 0 || s.size() < n) return 0;
+  for (std::size_t i = 1; i < n; ++i)
+    if ((byte(i) & 0xC0) != 0x80) return 0;
+  // (No overlong three- or four-byte forms, no surrogates, nothing above U+10FFFF.)
+  if ((lead == 0xE0 && byte(1) < 0xA0) || (lead == 0xED && byte(1) > 0x9F) ||
+      (lead == 0xF0 && byte(1) < 0x90) || (lead == 0xF4 && byte(1) > 0x8F))
+    return 0;
+  return n;
+}
+
 // A value quoted for an error message, cut to 40 characters: a binary file read as text must
-// not produce a screenful.
+// not produce a screenful. Bytes that are not text (control characters, NUL, bytes outside
+// well-formed UTF-8) are shown as \xHH, so the message stays one printable line whole.
 inline std::string quoted_excerpt(std::string_view text) {
   constexpr std::size_t kMax = 40;
+  const std::string_view kept = text.substr(0, kMax);
   std::string shown(1, '\'');
-  shown.append(text.substr(0, kMax));
+  for (std::size_t i = 0; i < kept.size();) {
+    const auto c = static_cast<unsigned char>(kept[i]);
+    if (c >= 0x20 && c < 0x7F) {
+      shown += kept[i++];
+    } else if (const std::size_t n = c >= 0x80 ? utf8_sequence(kept.substr(i)) : 0; n > 0) {
+      shown.append(kept.substr(i, n));
+      i += n;
+    } else {
+      shown += fmt::format("\\x{:02X}", c);
+      ++i;
+    }
+  }
   shown.append(text.size() > kMax ? "...'" : "'");
   return shown;
 }

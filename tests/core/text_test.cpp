@@ -36,6 +36,13 @@ TEST(Text, MessagesAndMarkup) {
   EXPECT_EQ(number_text(1e-6), "1e-06");
   EXPECT_EQ(quoted_excerpt("12x"), "'12x'");
   EXPECT_EQ(quoted_excerpt(std::string(50, 'z')), "'" + std::string(40, 'z') + "...'");
+  // Bytes of a binary file read as text: NUL and control characters escaped, the message whole.
+  EXPECT_EQ(quoted_excerpt(std::string("PIEH\x05\0\0\0ab", 10)), "'PIEH\\x05\\x00\\x00\\x00ab'");
+  EXPECT_EQ(quoted_excerpt("a\tb\nc\x7f"), "'a\\x09b\\x0Ac\\x7F'");
+  // Well-formed UTF-8 is text; a lone continuation byte, a cut sequence, an overlong form are not.
+  EXPECT_EQ(quoted_excerpt("caf\xc3\xa9 \xe2\x82\xac"), "'caf\xc3\xa9 \xe2\x82\xac'");
+  EXPECT_EQ(quoted_excerpt("\x80x\xc3"), "'\\x80x\\xC3'");
+  EXPECT_EQ(quoted_excerpt("\xe0\x80\x80"), "'\\xE0\\x80\\x80'");
   EXPECT_EQ(escape_markup("a < b & \"c\""), "a &lt; b &amp; &quot;c&quot;");
 }
 
