@@ -12,6 +12,7 @@
 #include "core/error.hpp"
 #include "core/text.hpp"
 #include "tracking/banded_mog2.hpp"
+#include "tracking/shadow_parts.hpp"
 #include "tracking/start_motion_impl.hpp"
 
 namespace roiflow::tracking {
@@ -33,6 +34,8 @@ void MotionDetectorParams::validate() const {
   if (!(split_width > 0 && split_width < 4))
     fail("split_width must be in (0, 4), got " + number_text(split_width));
   if (close_h < 0 || close_h > 64) fail("close_h must be in 0..64, got " + number_text(close_h));
+  if (!(shadow_enclosed >= 0 && shadow_enclosed <= 1))
+    fail("shadow_enclosed must be in [0, 1], got " + number_text(shadow_enclosed));
   if (!(join_gap >= 0 && join_gap <= 2))
     fail("join_gap must be in [0, 2], got " + number_text(join_gap));
   if (ghost_frames < 0 || ghost_frames > 100000)
@@ -101,7 +104,8 @@ constexpr int kReach = 11;
 
 struct MotionDetector::Impl {
   // Shadows are labelled (127) and then count as background: a pedestrian's or a car's shadow
-  // is not the object, and would merge neighbours into one blob.
+  // is not the object, and would merge neighbours into one blob. A shadow part that the
+  // foreground surrounds is the object's own grey body, not a shadow (shadow_parts.hpp).
   explicit Impl(const MotionDetectorParams& p)
       : model(BandedMog2Params{p.history, p.var_threshold, p.shadows, p.shadow_threshold,
                                p.background_ratio}) {}
@@ -368,6 +372,8 @@ Foreground MotionDetector::observe(const cv::Mat& image, const flow::FlowResult*
     input = &s.small;
   }
   s.model.apply(*input, s.raw, -1, executor);
+  if (params_.shadows && params_.shadow_enclosed > 0)
+    reclaim_enclosed_shadows(s.raw, params_.shadow_enclosed);
   ++s.observed;
   Foreground fg;
   fg.observed = s.observed;

@@ -78,6 +78,11 @@ struct MotionDetectorParams {
   bool shadows = true;            // MOG2 labels shadows, which then count as background
   double shadow_threshold = 0.5;  // MOG2's tau: a pixel darker than the background by a ratio in
                                   // [tau, 1) with its colour is a shadow, (0, 1)
+  double shadow_enclosed = 0.7;   // a shadow part whose outline lies next to the foreground for
+                                  // at least this share of its length is the body of an object
+                                  // (a grey car on asphalt), not its cast shadow, which touches
+                                  // its object on one side: it is foreground (shadow_parts.hpp).
+                                  // [0, 1], 0 = never
   int warmup = 5;                 // detect_objects finds nothing in the first frames observed
   int open = 3;                   // opening kernel side at work resolution (0 = none)
   int close = 7;                  // closing kernel width at work resolution (0 = none)
