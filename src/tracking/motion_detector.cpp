@@ -29,6 +29,8 @@ void MotionDetectorParams::validate() const {
   if (close < 0 || close > 64) fail("close must be in 0..64, got " + number_text(close));
   if (!(min_area >= 1) || !std::isfinite(min_area))
     fail("min_area must be >= 1, got " + number_text(min_area));
+  if (!(min_model_area >= 0) || !std::isfinite(min_model_area))
+    fail("min_model_area must be >= 0, got " + number_text(min_model_area));
   if (!(split_valley >= 0 && split_valley < 1))
     fail("split_valley must be in [0, 1), got " + number_text(split_valley));
   if (!(split_width > 0 && split_width < 4))
@@ -521,6 +523,12 @@ std::vector<cv::Rect2f> merge_nested(std::vector<cv::Rect2f> boxes, double overl
   return boxes;
 }
 
+double smallest_object(const MotionDetectorParams& params, int scale) {
+  const double model_pixel = static_cast<double>(scale) * scale;
+  return params.min_model_area > 0 ? std::min(params.min_area, params.min_model_area * model_pixel)
+                                   : params.min_area;
+}
+
 std::vector<Detection> detect_objects(const Foreground& fg, const MotionDetectorParams& params) {
   std::vector<Detection> out;
   if (fg.empty() || (fg.observed <= params.warmup && fg.motion.empty())) return out;
@@ -535,7 +543,8 @@ std::vector<Detection> detect_objects(const Foreground& fg, const MotionDetector
   cv::Mat labels, stats, centroids;
   const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
   const float s = static_cast<float>(fg.scale);
-  const double min_small = params.min_area / (static_cast<double>(fg.scale) * fg.scale);
+  const double min_area = smallest_object(params, fg.scale);
+  const double min_small = min_area / (static_cast<double>(fg.scale) * fg.scale);
   // The boxes of distinct motions are not merged with the others: two objects crossing overlap.
   std::vector<cv::Rect2f> boxes, by_motion;
   for (int i = 1; i < n; ++i) {
@@ -569,7 +578,7 @@ std::vector<Detection> detect_objects(const Foreground& fg, const MotionDetector
   boxes.insert(boxes.end(), by_motion.begin(), by_motion.end());
   for (const cv::Rect2f& b : boxes) {
     const cv::Rect2f box = b & frame;
-    if (box.area() < params.min_area) continue;
+    if (box.area() < min_area) continue;
     out.push_back({box, (box.tl() + box.br()) * 0.5f, box.area()});
   }
   std::sort(out.begin(), out.end(),

@@ -87,7 +87,11 @@ struct MotionDetectorParams {
   int open = 3;                   // opening kernel side at work resolution (0 = none)
   int close = 7;                  // closing kernel width at work resolution (0 = none)
   int close_h = 0;                // closing kernel height at work resolution (0 = close)
-  double min_area = 400;          // smallest object, full-resolution pixels of its box
+  double min_area = 400;          // smallest object, full-resolution pixels of its box, ...
+  double min_model_area = 100;    // ... or this many pixels at the model's resolution where
+                                  // that is less (a frame the model sees at full size, e.g.
+                                  // 320x240: a far car is a real object there, and the opening
+                                  // already removed the speckle); 0 = min_area alone
   double merge_overlap = 0.6;     // boxes whose intersection holds this share of the smaller one
                                   // merge, (0, 1]
   double split_valley = 0.7;      // a blob splits at a column where its count of moving pixels
@@ -155,6 +159,10 @@ class MotionDetector {
 // flow back to the previous frame: MotionDetector::wants_flow() for a pipeline that computes that
 // flow ahead of the background refresh.
 bool wants_flow(const MotionDetectorParams& params, long long index);
+
+// The smallest object's box area in full-resolution pixels for a model working `scale` times
+// smaller than the frame: min_area, or min_model_area model pixels where that is less.
+double smallest_object(const MotionDetectorParams& params, int scale);
 
 // The moving objects of one foreground (score = area in full-resolution pixels), biggest first;
 // empty during the warm-up. Thread-safe (reads only `fg`).

@@ -118,14 +118,15 @@ std::vector<cv::Rect2f> split_by_flow(const cv::Rect2f& box, const flow::Pyramid
   fg(in).copyTo(mask(in));
   mask &= moving;
   const cv::Mat labels(r.size(), CV_32S, cv::Scalar(1));
-  const int min_pixels = std::max(8 * scale * scale, static_cast<int>(0.25 * dp.min_area));
+  const double min_area = smallest_object(dp, scale);
+  const int min_pixels = std::max(8 * scale * scale, static_cast<int>(0.25 * min_area));
   std::vector<cv::Rect> modes =
       detail::motion_modes(labels, mask, motion, 1, in, dp.start_motion, min_pixels);
   std::vector<cv::Rect2f> boxes(modes.begin(), modes.end());
   boxes = merge_nested(std::move(boxes), dp.merge_overlap);
   for (cv::Rect2f& b : boxes)
     b += cv::Point2f(static_cast<float>(r.x), static_cast<float>(r.y));
-  std::erase_if(boxes, [&](const cv::Rect2f& b) { return b.area() < dp.min_area; });
+  std::erase_if(boxes, [&](const cv::Rect2f& b) { return b.area() < min_area; });
   if (boxes.size() >= 2) return boxes;
   if (boxes.size() != 1 || boxes[0].area() > params.split_keep * box.area()) return {};
   // One motion over a small part of the box: cut the rest when much of it stands still.
