@@ -9,29 +9,16 @@
 #include "core/error.hpp"
 #include "flow/dense_lk.hpp"
 #include "flow/pyramid.hpp"
+#include "hand_foreground.hpp"
 #include "mot_scene.hpp"
 #include "tracking/motion_split.hpp"
 
 namespace roiflow {
 namespace {
 
+using test::foreground_over;
 using test::MotScene;
 using tracking::MultiTrackerParams;
-
-// A hand-made foreground of a 320x240 frame at full resolution: `boxes` are moving.
-tracking::Foreground foreground_over(const std::vector<cv::Rect>& boxes) {
-  tracking::Foreground fg;
-  fg.observed = 100;
-  fg.scale = 1;
-  fg.frame_size = {320, 240};
-  fg.mask = cv::Mat(240, 320, CV_8U, cv::Scalar(0));
-  for (const cv::Rect& b : boxes)
-    fg.mask(b) = 255;
-  cv::Mat ones;
-  cv::threshold(fg.mask, ones, 0, 1, cv::THRESH_BINARY);
-  cv::integral(ones, fg.integral, CV_32S);
-  return fg;
-}
 
 tracking::TrackSet confirmed(const std::vector<cv::Rect2f>& boxes) {
   tracking::TrackSet s;

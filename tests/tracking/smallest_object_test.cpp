@@ -3,28 +3,15 @@
 // on hand-made foregrounds.
 #include <gtest/gtest.h>
 
-#include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
 
+#include "hand_foreground.hpp"
 #include "test_util.hpp"
 #include "tracking/motion_detector.hpp"
 
 namespace roiflow::tracking {
 namespace {
-
-// A hand-made foreground: `blobs` (model pixels) moving in a frame `scale` times the mask's size.
-Foreground foreground_of(int scale, const std::vector<cv::Rect>& blobs) {
-  Foreground fg;
-  fg.observed = 100;
-  fg.scale = scale;
-  fg.mask = cv::Mat(240, 320, CV_8U, cv::Scalar(0));
-  fg.frame_size = {320 * scale, 240 * scale};
-  for (const cv::Rect& b : blobs)
-    fg.mask(b) = 255;
-  cv::integral(fg.mask / 255, fg.integral, CV_32S);
-  return fg;
-}
 
 TEST(MotionDetector, TheSmallestObjectIsMinAreaOrMinModelAreaModelPixels) {
   MotionDetectorParams p;                 // min_area 400, min_model_area 100
@@ -37,9 +24,9 @@ TEST(MotionDetector, TheSmallestObjectIsMinAreaOrMinModelAreaModelPixels) {
   // car (126 pixels) is an object, as it was not under min_area alone; speckle of 9x9 is not.
   const std::vector<cv::Rect> blobs = {{40, 40, 14, 9}, {150, 120, 40, 30}, {250, 40, 9, 9}};
   MotionDetectorParams d;
-  EXPECT_EQ(detect_objects(foreground_of(1, blobs), d).size(), 2u);
+  EXPECT_EQ(detect_objects(test::foreground_over(blobs), d).size(), 2u);
   d.min_model_area = 0;
-  EXPECT_EQ(detect_objects(foreground_of(1, blobs), d).size(), 1u);
+  EXPECT_EQ(detect_objects(test::foreground_over(blobs), d).size(), 1u);
   d.min_model_area = -1;
   EXPECT_NE(test::error_message([&] { d.validate(); }).find("min_model_area"), std::string::npos);
 }
